@@ -1,0 +1,20 @@
+#pragma once
+// Procedural meshes for tests, benchmarks and demos.
+
+#include "vrdeform/mesh/tet_mesh.h"
+
+namespace vrd {
+
+/// Box [origin, origin + size] cut into nx*ny*nz cells of 6 positively oriented tets each
+/// (Kuhn subdivision along each cell's main diagonal, so neighbouring cells share faces).
+TetMesh makeBoxTets(const Vec3& origin, const Vec3& size, int nx, int ny, int nz);
+
+/// A box of roughly `targetTets` tets (within a few percent) with cells as close to cubes as
+/// the aspect ratio of `size` allows.
+TetMesh makeBoxTetsNear(const Vec3& origin, const Vec3& size, int targetTets);
+
+/// A rectangular cloth in the plane spanned by `uAxis` and `vAxis` from `origin`, nu*nv quads split
+/// into two triangles each; vertex (iu, iv) has index iv*(nu+1) + iu.
+TriMesh makeGridCloth(const Vec3& origin, const Vec3& uAxis, const Vec3& vAxis, int nu, int nv);
+
+}  // namespace vrd

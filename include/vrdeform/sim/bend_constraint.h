@@ -1,0 +1,71 @@
+#pragma once
+// Dihedral bending constraint between two triangles that share an edge (paper section 4.3, eq. 24).
+//
+// Particles: p1, p2 on the shared edge; p3 completes triangle A = (p1, p2, p3), p4 completes
+// triangle B = (p1, p2, p4). Eq. 24 measures the unsigned angle arccos(n1.n2), which is pi when
+// the pair is flat and has a kink there: bending either way lowers it, so its gradient flips sign
+// as the cloth passes through flat and the solver chatters. We use the signed bend angle theta
+// (0 when flat, positive folding one way, negative the other), which is pi - arccos(n1.n2) on
+// one side of flat and smooth through it, so C = theta - theta0 (wrapped to (-pi, pi]) is eq. 24
+// up to sign and keeps a gradient of constant direction.
+//
+// Gradient: the analytic gradient of Müller et al. 2007, appendix A, rewritten in the equivalent
+// closed form (Bridson et al. 2003) that has no 0/0 at flat: with e = p2 - p1, nA = e x (p3 - p1),
+// nB = (p4 - p1) x e and the edge coordinates s3 = (p3 - p1).e/|e|^2, s4 = (p4 - p1).e/|e|^2,
+//   grad_p3 = -|e| nA/|nA|^2,   grad_p4 = -|e| nB/|nB|^2,
+//   grad_p1 = -(1 - s3) grad_p3 - (1 - s4) grad_p4,   grad_p2 = -s3 grad_p3 - s4 grad_p4.
+// A moving p3 turns triangle A about the edge at rate 1/height. A triangle of (near) zero area
+// has no defined normal; the constraint then does nothing.
+
+#include <cmath>
+#include <numbers>
+
+#include "vrdeform/sim/xpbd.h"
+
+namespace vrd {
+
+struct BendConstraint {
+  Index i[4];        ///< p1, p2: shared edge; p3, p4: opposite vertices of the two triangles
+  float restAngle;   ///< theta0: signed bend angle at rest (rad), 0 for a flat rest pair
+  float compliance;  ///< alpha (1/(N m))
+};
+
+template <typename S>
+struct BendEval {
+  S theta;           ///< signed bend angle in (-pi, pi]
+  S C;               ///< theta - theta0 wrapped to (-pi, pi]
+  Vec3T<S> grad[4];  ///< zero when a triangle is degenerate
+};
+
+template <typename S>
+BendEval<S> evalBend(const Vec3T<S>& p1, const Vec3T<S>& p2, const Vec3T<S>& p3, const Vec3T<S>& p4, S restAngle) {
+  constexpr S pi = std::numbers::pi_v<S>;
+  BendEval<S> out{};
+  for (auto& g : out.grad) g.setZero();
+  const Vec3T<S> e = p2 - p1;
+  const S e2 = e.squaredNorm();
+  const Vec3T<S> nA = e.cross(p3 - p1), nB = (p4 - p1).cross(e);
+  const S nA2 = nA.squaredNorm(), nB2 = nB.squaredNorm();
+  const S tiny = S(1e-12) * e2 * e2;  // height below 1e-6 |e|
+  if (!(nA2 > tiny && nB2 > tiny)) return out;
+  const S eLength = std::sqrt(e2);
+  out.theta = std::atan2(nA.cross(nB).dot(e) / eLength, nA.dot(nB));
+  out.C = out.theta - restAngle;
+  if (out.C > pi) out.C -= 2 * pi;
+  if (out.C <= -pi) out.C += 2 * pi;
+  const S s3 = (p3 - p1).dot(e) / e2, s4 = (p4 - p1).dot(e) / e2;
+  out.grad[2] = -eLength / nA2 * nA;
+  out.grad[3] = -eLength / nB2 * nB;
+  out.grad[0] = -(1 - s3) * out.grad[2] - (1 - s4) * out.grad[3];
+  out.grad[1] = -s3 * out.grad[2] - s4 * out.grad[3];
+  return out;
+}
+
+/// Eq. 24 projected with eqs. 1 and 3.
+inline Correction<4> solveBend(const Point (&p)[4], float restAngle, float lambda, const XpbdCoefficients& k,
+                               const Vec3* disp = nullptr) {
+  const BendEval<float> e = evalBend(p[0].pos, p[1].pos, p[2].pos, p[3].pos, restAngle);
+  return projectScalar(p, e.C, e.grad, lambda, k, disp);
+}
+
+}  // namespace vrd

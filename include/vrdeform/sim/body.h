@@ -1,0 +1,39 @@
+#pragma once
+// Runtime state of one body in a world: where its particles are, its multipliers and its health.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "vrdeform/sim/body_model.h"
+
+namespace vrd {
+
+using BodyId = std::uint32_t;
+
+enum class BodyState : std::uint8_t {
+  Active,  ///< simulated
+  Frozen,  ///< stopped after a non-finite value appeared; holds its last finite state
+};
+
+struct Body {
+  std::shared_ptr<const BodyModel> model;
+  Index firstParticle = 0;  ///< the body's particles are [firstParticle, firstParticle + particleCount)
+  Index particleCount = 0;
+  BodyState state = BodyState::Active;
+
+  // Multipliers of the last substep, one per constraint in the model's order. lambda/h^2 with the
+  // substep h is the constraint's generalised force: N for distances, N/m^2 for volumes, N m for
+  // angles; the strain multipliers are per component (stretch 00, 11, 22, shear 01, 02, 12).
+  std::vector<float> distanceLambda;
+  std::vector<float> volumeLambda;
+  std::vector<StrainLambda> strainLambda;
+  std::vector<float> bendLambda;
+  std::vector<Vec3> shapeMatchLambda;
+  Quat shapeMatchRotation = Quat::Identity();  ///< R of the last shape-matching projection (warm start)
+
+  std::vector<Vec3> initialPositions;  ///< world positions at creation; resetBody() returns them at rest
+};
+
+}  // namespace vrd

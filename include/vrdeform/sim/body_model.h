@@ -1,0 +1,73 @@
+#pragma once
+// A body's rest data and constraint arrays: computed once per mesh and material, immutable while
+// simulating, and shared by every body instance made from it. Runtime state lives in Body.
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "vrdeform/mesh/tet_mesh.h"
+#include "vrdeform/sim/bend_constraint.h"
+#include "vrdeform/sim/distance_constraint.h"
+#include "vrdeform/sim/material.h"
+#include "vrdeform/sim/shape_matching.h"
+#include "vrdeform/sim/strain_constraint.h"
+#include "vrdeform/sim/volume_constraint.h"
+
+namespace vrd {
+
+/// Which constraints a soft body gets from its tet mesh.
+struct ConstraintSet {
+  bool edges = false;         ///< a distance constraint per tet edge
+  bool volume = true;         ///< one per tet (eqs. 16-23)
+  bool strain = true;         ///< six per tet (eqs. 29-34)
+  bool shapeMatching = true;  ///< one per body (eqs. 25-28)
+
+  static ConstraintSet paper() { return {}; }  ///< volume + strain + shape matching (paper Table 1)
+  static ConstraintSet edgesAndVolume() { return {true, true, false, false}; }
+};
+
+/// Rayleigh damping beta (s) of each constraint type.
+struct ConstraintDamping {
+  float distance = 0, volume = 0, strainStretch = 0, strainShear = 0, bend = 0, shapeMatching = 0;
+};
+
+struct BodyModel {
+  std::vector<Vec3> restPositions;  ///< body-local rest positions
+  std::vector<float> invMass;       ///< inverse masses (1/kg), 0 = kinematic
+  std::vector<Tet> tets;            ///< the volume elements (soft bodies), for volume and volume loss
+  std::vector<Triangle> triangles;  ///< the cloth triangles (cloth)
+
+  std::vector<DistanceConstraint> distance;
+  std::vector<VolumeConstraint> volume;
+  std::vector<StrainConstraint> strain;
+  std::vector<BendConstraint> bend;
+  std::optional<ShapeMatchModel> shapeMatching;
+
+  ConstraintDamping damping;
+  float particleRadius = 0.0f;  ///< contact offset against colliders (m)
+  double restVolume = 0.0;      ///< sum of the tets' rest volumes (m^3)
+
+  std::size_t particleCount() const { return restPositions.size(); }
+};
+
+/// Builds a soft body from a tet mesh. Throws vrd::Error naming the element for a degenerate or
+/// inverted rest tet, a non-finite coordinate, an out-of-range index or an invalid material.
+std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Material& material,
+                                              const ConstraintSet& constraints = ConstraintSet::paper());
+
+/// Builds a cloth from a triangle mesh: a distance constraint per edge and a bending constraint
+/// per interior edge. Needs a compliance material (no moduli).
+std::shared_ptr<const BodyModel> makeCloth(const TriMesh& mesh, const Material& material);
+
+/// Appends a distance constraint whose rest length is the rest distance of particles a and b.
+void addDistanceConstraint(BodyModel& model, Index a, Index b, float compliance);
+
+/// Builds the shape-matching rest frame from the model's rest positions and masses.
+ShapeMatchModel makeShapeMatchModel(const BodyModel& model, float compliance);
+
+/// Checks a hand-built or loaded model: finite positions, inverse masses finite and >= 0,
+/// constraint indices in range, finite non-negative compliances. Throws vrd::Error naming the item.
+void validateModel(const BodyModel& model);
+
+}  // namespace vrd

@@ -1,0 +1,41 @@
+#pragma once
+// Material settings of a body: per-constraint-type compliance and damping as in the paper, or
+// Young's modulus, Poisson ratio and density mapped onto them (docs/materials.md).
+
+#include <optional>
+
+namespace vrd {
+
+/// Compliance alpha (inverse stiffness, in the constraint's units) and Rayleigh damping beta (s)
+/// of one constraint type.
+struct ConstraintMaterial {
+  float compliance;
+  float damping;
+};
+
+/// Linear-elastic moduli. When a material has them, the builder derives per-element compliances
+/// so that volume + strain constraints reproduce isotropic linear elasticity at small strain, and
+/// lumps particle masses from the density.
+struct ElasticModuli {
+  float youngsModulus;  ///< E (Pa)
+  float poissonRatio;   ///< nu, in [0, 0.5)
+  float density;        ///< rho (kg/m^3)
+};
+
+struct Material {
+  float particleMass = 1.0f;  ///< kg per particle when no moduli are given (the paper uses 1.0)
+
+  // The paper's ranges: compliance 0.2-0.4, damping 0.02-0.05.
+  ConstraintMaterial distance{0.3f, 0.03f};       ///< stretch (eqs. 7-15); cloth edges and tet edges
+  ConstraintMaterial volume{0.3f, 0.03f};         ///< tet volume (eqs. 16-23)
+  ConstraintMaterial strainStretch{0.3f, 0.03f};  ///< S_ii - 1 (eq. 33)
+  ConstraintMaterial strainShear{0.3f, 0.03f};    ///< S_ij (eq. 34)
+  ConstraintMaterial shapeMatching{0.3f, 0.03f};  ///< p_i - g_i (eq. 28), per unit mass
+  ConstraintMaterial bending{0.3f, 0.03f};        ///< dihedral angle (eq. 24)
+
+  std::optional<ElasticModuli> elastic;  ///< overrides particleMass and the distance, volume and strain compliances
+
+  float particleRadius = 0.0f;  ///< particles keep this distance from colliders (m); cloth thickness
+};
+
+}  // namespace vrd

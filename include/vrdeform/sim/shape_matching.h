@@ -1,0 +1,61 @@
+#pragma once
+// Global shape matching of a whole body (paper section 4.4, eqs. 25-28).
+//
+// Goal positions g_i = c2 + R (x_i - c1) (eq. 27), where c1 and c2 are the mass-weighted centroids
+// of the rest and current shapes and R is the rotation minimising eq. 25. That minimiser is the
+// rotation of A_pq = sum_i m_i (p_i - c2)(x_i - c1)^T (Müller et al. 2005); eq. 26's extra factor
+// A_qq^-1 is symmetric and only matters for linear (non-rigid) matching, so we leave it out.
+// R comes from the robust extraction of math/rotation.h, which also handles inverted and flat
+// shapes. Each particle then gets the vector constraint C_i = p_i - g_i (eq. 28), projected with
+// eqs. 1 and 3 with the goal held fixed.
+//
+// Compliance is per unit mass, alpha_i = alpha / m_i: the energy (m_i / 2 alpha) |p_i - g_i|^2 pulls
+// every particle back at the same rate whatever its mass, and the corrections then conserve linear
+// and angular momentum (sum_i m_i (g_i - p_i) = 0 and sum_i m_i (p_i - c2) x (g_i - p_i) = 0 at the
+// optimal R). With the paper's unit masses it is the plain compliance.
+
+#include <vector>
+
+#include "vrdeform/math/rotation.h"
+#include "vrdeform/sim/xpbd.h"
+
+namespace vrd {
+
+struct ShapeMatchModel {
+  Vec3 restCentroid;              ///< c1 (eq. 25's t0)
+  std::vector<Vec3> restOffsets;  ///< x_i - c1, one per particle of the body
+  std::vector<float> mass;        ///< m_i, the weights of eq. 25
+  float totalMass;
+  float compliance;               ///< alpha (m/N for a 1 kg particle; see above)
+};
+
+struct ShapeMatchFrame {
+  Vec3 centroid;  ///< c2
+  Mat3 rotation;  ///< R
+};
+
+/// Eqs. 25-27: centroid and best-fit rotation of the current positions. `rotation` warm-starts
+/// the extraction and receives the result.
+inline ShapeMatchFrame shapeMatchFrame(const Point* p, const ShapeMatchModel& model, Quat& rotation) {
+  const std::size_t n = model.restOffsets.size();
+  Vec3 weighted = Vec3::Zero();
+  Mat3 Apq = Mat3::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    weighted += model.mass[i] * p[i].pos;
+    // sum_i m_i (p_i - c2) q_i^T = sum_i m_i p_i q_i^T because sum_i m_i q_i = 0.
+    Apq.noalias() += (model.mass[i] * p[i].pos) * model.restOffsets[i].transpose();
+  }
+  extractRotation(Apq, rotation);
+  return {weighted / model.totalMass, rotation.toRotationMatrix()};
+}
+
+/// Eq. 28 for one particle: the change of its vector multiplier; its correction is w dLambda.
+/// `k` holds alpha/h^2 and alpha*beta/h of a unit-mass particle; `disp` its motion in the substep.
+inline Vec3 solveShapeMatchParticle(const Point& p, const Vec3& goal, const Vec3& lambda, const XpbdCoefficients& k,
+                                    const Vec3& disp = Vec3::Zero()) {
+  if (p.w == 0.0f) return Vec3::Zero();
+  const float alphaTilde = k.alphaTilde * p.w, gamma = k.gamma * p.w;
+  return (goal - p.pos - alphaTilde * lambda - gamma * disp) / ((1.0f + gamma) * p.w + alphaTilde);
+}
+
+}  // namespace vrd

@@ -1,0 +1,137 @@
+#pragma once
+// A simulation world: bodies, attachments, colliders and fingertips, stepped with XPBD
+// (Algorithm 1) by one serial Gauss-Seidel solver.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "vrdeform/metrics/stage_times.h"
+#include "vrdeform/sim/attachment.h"
+#include "vrdeform/sim/body.h"
+#include "vrdeform/sim/contact.h"
+#include "vrdeform/sim/solver_settings.h"
+
+namespace vrd {
+
+using AttachmentId = std::uint32_t;
+using ColliderId = std::uint32_t;
+using FingertipId = std::uint32_t;
+
+/// Something the caller should know about, e.g. a body frozen after a NaN appeared.
+struct SimEvent {
+  std::uint64_t step;  ///< the step in which it happened (0-based)
+  BodyId body;
+  std::string message;
+};
+
+/// What the last call to step() did.
+struct StepReport {
+  std::uint64_t step = 0;             ///< index of the step (0-based)
+  StageTimes times;                   ///< summed over substeps and iterations
+  std::size_t colliderContacts = 0;   ///< in the last substep
+  std::size_t fingertipContacts = 0;  ///< in the last substep
+};
+
+class World {
+public:
+  explicit World(const SolverSettings& settings = {});
+
+  const SolverSettings& settings() const { return settings_; }
+  void setSettings(const SolverSettings& settings);  ///< validated; takes effect at the next step
+  float substepSize() const { return settings_.substepSize(); }
+
+  // --- Bodies --------------------------------------------------------------------------------
+  /// Adds a body whose particles start at rotation * rest + translation, at rest. The model is
+  /// validated (vrd::Error on bad input) and may be shared by several bodies.
+  BodyId addBody(std::shared_ptr<const BodyModel> model, const Vec3& translation = Vec3::Zero(),
+                 const Quat& rotation = Quat::Identity());
+  std::size_t bodyCount() const { return bodies_.size(); }
+  const Body& body(BodyId id) const { return bodies_.at(id); }
+  /// Puts a body back in its initial pose at rest and makes it active again.
+  void resetBody(BodyId id);
+
+  /// All particles. Positions (x) and velocities (v) may be written between steps, e.g. to move
+  /// kinematic particles (w = 0), which follow their velocity, or to prescribe a grasp (eq. 35).
+  Particles& particles() { return particles_; }
+  const Particles& particles() const { return particles_; }
+  Index particleIndex(BodyId body, Index local) const { return bodies_.at(body).firstParticle + local; }
+  /// Sets a particle's inverse mass; 0 makes it kinematic.
+  void setInverseMass(Index particle, float w);
+
+  // --- Attachments -----------------------------------------------------------------------------
+  /// Holds a particle at `target` along the world axes set in `axes` (1 = held).
+  AttachmentId attach(Index particle, const Vec3& target, float compliance = 0.0f, const Vec3& axes = Vec3::Ones(),
+                      float damping = 0.0f);
+  /// Moves an attachment's target to `goal` over the next step.
+  void moveAttachment(AttachmentId id, const Vec3& goal);
+  void detach(AttachmentId id);
+  const Attachment& attachment(AttachmentId id) const { return attachments_.at(id); }
+  /// Force the attachment applied to its particle in the last substep (N).
+  Vec3 attachmentForce(AttachmentId id) const;
+
+  // --- Colliders and fingertips ------------------------------------------------------------------
+  ColliderId addCollider(const Collider& collider);
+  const std::vector<Collider>& colliders() const { return colliders_; }
+
+  FingertipId addFingertip(const Vec3& center, float radius, float compliance = 0.0f);
+  /// Moves a fingertip's centre to `goal` over the next step.
+  void moveFingertip(FingertipId id, const Vec3& goal);
+  const Fingertip& fingertip(FingertipId id) const { return fingertips_.at(id); }
+  std::size_t fingertipCount() const { return fingertips_.size(); }
+  /// Total force the fingertip applied to the bodies in the last substep (N).
+  Vec3 fingertipForce(FingertipId id) const;
+  /// Number of particles in the fingertip's contact set N(r) in the last substep.
+  std::size_t fingertipContactCount(FingertipId id) const;
+
+  const std::vector<ColliderContact>& colliderContacts() const { return colliderContacts_; }
+  const std::vector<float>& colliderContactNormalLambda() const { return contactNormalLambda_; }
+  const std::vector<Vec3>& colliderContactFrictionLambda() const { return contactFrictionLambda_; }
+  const std::vector<FingertipContact>& fingertipContacts() const { return fingertipContacts_; }
+  const std::vector<float>& fingertipContactLambda() const { return fingertipLambda_; }
+
+  // --- Stepping ---------------------------------------------------------------------------------
+  /// Advances the world by one time step: `substeps` x (predict, detect, `iterations` Gauss-Seidel
+  /// sweeps, finalise).
+  void step();
+  const StepReport& lastStep() const { return report_; }
+  std::uint64_t stepCount() const { return stepCount_; }
+  /// Returns and clears the events since the last call.
+  std::vector<SimEvent> takeEvents();
+
+  // --- Measurements -------------------------------------------------------------------------------
+  /// Sum of the signed volumes of the body's tets at its current positions (m^3).
+  double volume(BodyId id) const;
+  /// Volume loss e = (v0 - v)/v0 (paper section 6.1).
+  double volumeLoss(BodyId id) const;
+  /// Net constraint force on each of the body's particles in the last substep (N):
+  /// sum over every constraint j acting on particle i of grad_i C_j lambda_j / h^2, including
+  /// attachments and contacts. At rest it balances the particle's weight and external force.
+  std::vector<Vec3> particleConstraintForces(BodyId id) const;
+
+private:
+  void predict(float h);
+  void detectContacts(float h);
+  void resetMultipliers();
+  void solveIteration(float h);
+  void finalise(float h);
+  void containNonFinite(BodyId id);
+
+  SolverSettings settings_;
+  Particles particles_;
+  std::vector<Body> bodies_;
+  std::vector<Attachment> attachments_;  // detached ones have particle == kNoParticle
+  std::vector<Vec3> attachmentLambda_;
+  std::vector<Collider> colliders_;
+  std::vector<ColliderContact> colliderContacts_;
+  std::vector<float> contactNormalLambda_;
+  std::vector<Vec3> contactFrictionLambda_;
+  std::vector<Fingertip> fingertips_;
+  std::vector<FingertipContact> fingertipContacts_;
+  std::vector<float> fingertipLambda_;
+  std::vector<SimEvent> events_;
+  StepReport report_;
+  std::uint64_t stepCount_ = 0;
+};
+
+}  // namespace vrd

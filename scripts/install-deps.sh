@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs every build and test dependency of vrdeform from Debian bookworm packages.
+# Does nothing when all are present, so the run and test scripts can call it every time.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libeigen3-dev       # small fixed-size maths
+  libcli11-dev        # command-line parsing
+  libfmt-dev          # formatting of reports
+  libgtest-dev libgmock-dev googletest   # unit tests
+  libbenchmark-dev    # benchmarks
+  clang-format        # code style check
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+echo "install-deps: installing ${missing[*]}"
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "install-deps: need root or sudo to apt-get install ${missing[*]}" >&2; exit 1; }
+  sudo="sudo"
+fi
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,493 @@
+#include "vrdeform/sim/world.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <limits>
+#include <type_traits>
+#include <utility>
+
+#include "vrdeform/error.h"
+
+namespace vrd {
+namespace {
+
+constexpr Index kNoParticle = std::numeric_limits<Index>::max();
+
+void checkFinite(const Vec3& v, const char* what) {
+  if (!isFinite(v)) throw Error(fmt::format("{}: non-finite value ({}, {}, {})", what, v.x(), v.y(), v.z()));
+}
+
+void checkCompliance(float compliance, const char* what) {
+  if (!(std::isfinite(compliance) && compliance >= 0.0f))
+    throw Error(fmt::format("{}: compliance must be finite and >= 0, got {}", what, compliance));
+}
+
+// Loads the constraint's particles and, when damped, their motion since the start of the substep.
+template <std::size_t N, bool Damped>
+struct Gathered {
+  Point p[N];
+  Vec3 disp[N];
+
+  Gathered(const Index (&idx)[N], const Point* pred, const Point* start) {
+    for (std::size_t k = 0; k < N; ++k) {
+      p[k] = pred[idx[k]];
+      if constexpr (Damped) disp[k] = p[k].pos - start[idx[k]].pos;
+    }
+  }
+  const Vec3* displacement() const { return Damped ? disp : nullptr; }
+};
+
+template <std::size_t N>
+void scatter(const Index (&idx)[N], const Vec3 (&dp)[N], Point* pred) {
+  for (std::size_t k = 0; k < N; ++k) pred[idx[k]].pos += dp[k];
+}
+
+// One Gauss-Seidel sweep over a scalar constraint type: gather, project, scatter.
+template <bool Damped, typename C, typename Solve>
+void sweep(const std::vector<C>& constraints, float* lambda, Point* pred, const Point* start, float beta, float invH,
+           Solve solve) {
+  for (std::size_t c = 0; c < constraints.size(); ++c) {
+    const C& con = constraints[c];
+    const Gathered<std::extent_v<decltype(C::i)>, Damped> g(con.i, pred, start);
+    const auto r = solve(con, g.p, lambda[c], XpbdCoefficients::make(con.compliance, beta, invH), g.displacement());
+    lambda[c] += r.dLambda;
+    scatter(con.i, r.dp, pred);
+  }
+}
+
+template <typename C, typename Solve>
+void sweepScalar(const std::vector<C>& constraints, std::vector<float>& lambda, Point* pred, const Point* start,
+                 float beta, float invH, Solve solve) {
+  if (beta > 0.0f)
+    sweep<true>(constraints, lambda.data(), pred, start, beta, invH, solve);
+  else
+    sweep<false>(constraints, lambda.data(), pred, start, beta, invH, solve);
+}
+
+template <bool Damped>
+void sweepStrain(const std::vector<StrainConstraint>& constraints, StrainLambda* lambda, Point* pred,
+                 const Point* start, const ConstraintDamping& damping, float invH) {
+  for (std::size_t c = 0; c < constraints.size(); ++c) {
+    const StrainConstraint& con = constraints[c];
+    const Gathered<4, Damped> g(con.i, pred, start);
+    const StrainCorrection r = solveStrain(
+        g.p, con.invRestShape, lambda[c], XpbdCoefficients::make(con.stretchCompliance, damping.strainStretch, invH),
+        XpbdCoefficients::make(con.shearCompliance, damping.strainShear, invH), g.displacement());
+    for (int k = 0; k < kStrainComponents; ++k) lambda[c][k] += r.dLambda[k];
+    scatter(con.i, r.dp, pred);
+  }
+}
+
+void sweepShapeMatching(const ShapeMatchModel& sm, Vec3* lambda, Quat& rotation, Point* pred, const Point* start,
+                        float beta, float invH) {
+  const ShapeMatchFrame frame = shapeMatchFrame(pred, sm, rotation);
+  const XpbdCoefficients k = XpbdCoefficients::make(sm.compliance, beta, invH);
+  for (std::size_t i = 0; i < sm.restOffsets.size(); ++i) {
+    const Vec3 goal = frame.centroid + frame.rotation * sm.restOffsets[i];
+    const Vec3 disp = beta > 0.0f ? Vec3(pred[i].pos - start[i].pos) : Vec3::Zero();
+    const Vec3 dLambda = solveShapeMatchParticle(pred[i], goal, lambda[i], k, disp);
+    lambda[i] += dLambda;
+    pred[i].pos += pred[i].w * dLambda;
+  }
+}
+
+}  // namespace
+
+World::World(const SolverSettings& settings) { setSettings(settings); }
+
+void World::setSettings(const SolverSettings& settings) {
+  validateSolverSettings(settings);
+  settings_ = settings;
+}
+
+BodyId World::addBody(std::shared_ptr<const BodyModel> model, const Vec3& translation, const Quat& rotation) {
+  if (!model) throw Error("addBody: no model");
+  validateModel(*model);
+  checkFinite(translation, "addBody translation");
+  if (!(rotation.coeffs().allFinite() && std::abs(rotation.norm() - 1.0f) < 1e-3f))
+    throw Error("addBody: rotation must be a unit quaternion");
+
+  Body body;
+  body.model = model;
+  body.firstParticle = Index(particles_.size());
+  body.particleCount = Index(model->particleCount());
+  body.distanceLambda.assign(model->distance.size(), 0.0f);
+  body.volumeLambda.assign(model->volume.size(), 0.0f);
+  body.strainLambda.assign(model->strain.size(), StrainLambda{});
+  body.bendLambda.assign(model->bend.size(), 0.0f);
+  body.shapeMatchLambda.assign(model->shapeMatching ? model->particleCount() : 0, Vec3::Zero());
+  body.shapeMatchRotation = rotation;
+  for (std::size_t i = 0; i < model->particleCount(); ++i) {
+    const Vec3 x = rotation * model->restPositions[i] + translation;
+    body.initialPositions.push_back(x);
+    particles_.x.push_back({x, model->invMass[i]});
+    particles_.p.push_back({x, model->invMass[i]});
+    particles_.v.push_back(Vec3::Zero());
+    particles_.force.push_back(Vec3::Zero());
+  }
+  bodies_.push_back(std::move(body));
+  return BodyId(bodies_.size() - 1);
+}
+
+void World::resetBody(BodyId id) {
+  Body& b = bodies_.at(id);
+  for (Index i = 0; i < b.particleCount; ++i) {
+    const Index g = b.firstParticle + i;
+    particles_.x[g].pos = particles_.p[g].pos = b.initialPositions[i];
+    particles_.v[g].setZero();
+  }
+  std::fill(b.distanceLambda.begin(), b.distanceLambda.end(), 0.0f);
+  std::fill(b.volumeLambda.begin(), b.volumeLambda.end(), 0.0f);
+  std::fill(b.strainLambda.begin(), b.strainLambda.end(), StrainLambda{});
+  std::fill(b.bendLambda.begin(), b.bendLambda.end(), 0.0f);
+  std::fill(b.shapeMatchLambda.begin(), b.shapeMatchLambda.end(), Vec3::Zero());
+  b.shapeMatchRotation = Quat::Identity();
+  b.state = BodyState::Active;
+}
+
+void World::setInverseMass(Index particle, float w) {
+  if (particle >= particles_.size()) throw Error(fmt::format("setInverseMass: no particle {}", particle));
+  if (!(std::isfinite(w) && w >= 0.0f)) throw Error(fmt::format("setInverseMass: inverse mass must be >= 0, got {}", w));
+  particles_.x[particle].w = particles_.p[particle].w = w;
+}
+
+AttachmentId World::attach(Index particle, const Vec3& target, float compliance, const Vec3& axes, float damping) {
+  if (particle >= particles_.size()) throw Error(fmt::format("attach: no particle {}", particle));
+  checkFinite(target, "attach target");
+  checkCompliance(compliance, "attach");
+  if (!((axes.array() == 0.0f) || (axes.array() == 1.0f)).all()) throw Error("attach: axes must be 0 or 1 each");
+  if (!(std::isfinite(damping) && damping >= 0.0f)) throw Error("attach: damping must be finite and >= 0");
+  const Attachment a{particle, target, target, axes, compliance, damping};
+  for (std::size_t id = 0; id < attachments_.size(); ++id)
+    if (attachments_[id].particle == kNoParticle) {
+      attachments_[id] = a;
+      attachmentLambda_[id].setZero();
+      return AttachmentId(id);
+    }
+  attachments_.push_back(a);
+  attachmentLambda_.push_back(Vec3::Zero());
+  return AttachmentId(attachments_.size() - 1);
+}
+
+void World::moveAttachment(AttachmentId id, const Vec3& goal) {
+  checkFinite(goal, "moveAttachment goal");
+  attachments_.at(id).goal = goal;
+}
+
+void World::detach(AttachmentId id) {
+  attachments_.at(id).particle = kNoParticle;
+  attachmentLambda_[id].setZero();
+}
+
+Vec3 World::attachmentForce(AttachmentId id) const {
+  const float h = substepSize();
+  return attachmentLambda_.at(id) / (h * h);
+}
+
+ColliderId World::addCollider(const Collider& collider) {
+  validateCollider(collider);
+  colliders_.push_back(collider);
+  return ColliderId(colliders_.size() - 1);
+}
+
+FingertipId World::addFingertip(const Vec3& center, float radius, float compliance) {
+  checkFinite(center, "addFingertip centre");
+  if (!(std::isfinite(radius) && radius > 0.0f)) throw Error(fmt::format("addFingertip: radius must be positive, got {}", radius));
+  checkCompliance(compliance, "addFingertip");
+  fingertips_.push_back({center, center, radius, compliance});
+  return FingertipId(fingertips_.size() - 1);
+}
+
+void World::moveFingertip(FingertipId id, const Vec3& goal) {
+  checkFinite(goal, "moveFingertip goal");
+  fingertips_.at(id).goal = goal;
+}
+
+Vec3 World::fingertipForce(FingertipId id) const {
+  const float h = substepSize();
+  Vec3 force = Vec3::Zero();
+  const Fingertip& f = fingertips_.at(id);
+  for (std::size_t c = 0; c < fingertipContacts_.size(); ++c)
+    if (fingertipContacts_[c].fingertip == id)
+      force += fingertipLambda_[c] * evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, f.center, f.radius).n;
+  return force / (h * h);
+}
+
+std::size_t World::fingertipContactCount(FingertipId id) const {
+  return std::size_t(std::count_if(fingertipContacts_.begin(), fingertipContacts_.end(),
+                                   [id](const FingertipContact& c) { return c.fingertip == id; }));
+}
+
+std::vector<SimEvent> World::takeEvents() { return std::exchange(events_, {}); }
+
+void World::step() {
+  report_ = StepReport{};
+  report_.step = stepCount_;
+  const int n = settings_.substeps;
+  const float h = settings_.substepSize();
+  for (int s = 0; s < n; ++s) {
+    // Kinematic targets move linearly from where they were to their goals over the step.
+    const float share = 1.0f / float(n - s);
+    for (Attachment& a : attachments_) a.target += share * (a.goal - a.target);
+    for (Fingertip& f : fingertips_) f.center += share * (f.goal - f.center);
+
+    predict(h);
+    detectContacts(h);
+    resetMultipliers();
+    for (int it = 0; it < settings_.iterations; ++it) solveIteration(h);
+    finalise(h);
+  }
+  report_.colliderContacts = colliderContacts_.size();
+  report_.fingertipContacts = fingertipContacts_.size();
+  ++stepCount_;
+}
+
+void World::predict(float h) {
+  StageTimer timer(report_.times, Stage::Predict, settings_.timeStages);
+  const float keep = std::max(0.0f, 1.0f - settings_.linearDamping * h);
+  for (const Body& b : bodies_) {
+    if (b.state != BodyState::Active) continue;
+    for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
+      const Point& x = particles_.x[i];
+      Vec3& v = particles_.v[i];
+      if (x.w > 0.0f) v = keep * v + h * (settings_.gravity + x.w * particles_.force[i]);  // damp, then add forces
+      particles_.p[i] = {x.pos + h * v, x.w};  // kinematic particles follow their velocity
+    }
+  }
+}
+
+void World::detectContacts(float /*h*/) {
+  StageTimer timer(report_.times, Stage::Detect, settings_.timeStages);
+  colliderContacts_.clear();
+  fingertipContacts_.clear();
+  for (const Body& b : bodies_) {
+    if (b.state != BodyState::Active) continue;
+    const float radius = b.model->particleRadius;
+    for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
+      const Point& p = particles_.p[i];
+      if (p.w == 0.0f) continue;
+      // Anything the particle could reach in this substep: its predicted motion as margin.
+      const float margin = radius + (p.pos - particles_.x[i].pos).norm();
+      for (Index c = 0; c < colliders_.size(); ++c)
+        if (closestSurface(colliders_[c], p.pos).distance < margin) colliderContacts_.push_back({i, c, radius});
+      // Eq. 36: the fingertip's contact set N(r) from the predicted positions.
+      for (Index f = 0; f < fingertips_.size(); ++f)
+        if ((p.pos - fingertips_[f].center).squaredNorm() <= fingertips_[f].radius * fingertips_[f].radius)
+          fingertipContacts_.push_back({i, f});
+    }
+  }
+}
+
+void World::resetMultipliers() {
+  for (Body& b : bodies_) {
+    std::fill(b.distanceLambda.begin(), b.distanceLambda.end(), 0.0f);
+    std::fill(b.volumeLambda.begin(), b.volumeLambda.end(), 0.0f);
+    std::fill(b.strainLambda.begin(), b.strainLambda.end(), StrainLambda{});
+    std::fill(b.bendLambda.begin(), b.bendLambda.end(), 0.0f);
+    std::fill(b.shapeMatchLambda.begin(), b.shapeMatchLambda.end(), Vec3::Zero());
+  }
+  std::fill(attachmentLambda_.begin(), attachmentLambda_.end(), Vec3::Zero());
+  contactNormalLambda_.assign(colliderContacts_.size(), 0.0f);
+  contactFrictionLambda_.assign(colliderContacts_.size(), Vec3::Zero());
+  fingertipLambda_.assign(fingertipContacts_.size(), 0.0f);
+}
+
+void World::solveIteration(float h) {
+  const float invH = 1.0f / h;
+  const bool timed = settings_.timeStages;
+  StageTimes& times = report_.times;
+  Point* const pred = particles_.p.data();
+  const Point* const start = particles_.x.data();
+
+  for (Body& b : bodies_) {
+    if (b.state != BodyState::Active) continue;
+    const BodyModel& m = *b.model;
+    Point* p = pred + b.firstParticle;
+    const Point* x = start + b.firstParticle;
+    if (!m.distance.empty()) {
+      StageTimer t(times, Stage::Distance, timed);
+      sweepScalar(m.distance, b.distanceLambda, p, x, m.damping.distance, invH,
+                  [](const DistanceConstraint& c, const Point(&q)[2], float l, const XpbdCoefficients& k,
+                     const Vec3* d) { return solveDistance(q, c.restLength, l, k, d); });
+    }
+    if (!m.volume.empty()) {
+      StageTimer t(times, Stage::Volume, timed);
+      sweepScalar(m.volume, b.volumeLambda, p, x, m.damping.volume, invH,
+                  [](const VolumeConstraint& c, const Point(&q)[4], float l, const XpbdCoefficients& k,
+                     const Vec3* d) { return solveVolume(q, c.restVolume, l, k, d); });
+    }
+    if (!m.strain.empty()) {
+      StageTimer t(times, Stage::Strain, timed);
+      if (m.damping.strainStretch > 0.0f || m.damping.strainShear > 0.0f)
+        sweepStrain<true>(m.strain, b.strainLambda.data(), p, x, m.damping, invH);
+      else
+        sweepStrain<false>(m.strain, b.strainLambda.data(), p, x, m.damping, invH);
+    }
+    if (!m.bend.empty()) {
+      StageTimer t(times, Stage::Bend, timed);
+      sweepScalar(m.bend, b.bendLambda, p, x, m.damping.bend, invH,
+                  [](const BendConstraint& c, const Point(&q)[4], float l, const XpbdCoefficients& k,
+                     const Vec3* d) { return solveBend(q, c.restAngle, l, k, d); });
+    }
+    if (m.shapeMatching) {
+      StageTimer t(times, Stage::ShapeMatching, timed);
+      sweepShapeMatching(*m.shapeMatching, b.shapeMatchLambda.data(), b.shapeMatchRotation, p, x,
+                         m.damping.shapeMatching, invH);
+    }
+  }
+
+  // World-level constraints come last in the sweep so that they have the last word (P3).
+  if (!attachments_.empty()) {
+    StageTimer t(times, Stage::Attachment, timed);
+    for (std::size_t a = 0; a < attachments_.size(); ++a) {
+      const Attachment& at = attachments_[a];
+      if (at.particle == kNoParticle) continue;
+      Point& q = pred[at.particle];
+      const Vec3 dLambda = solveAttachment(q, at.target, at.axes, attachmentLambda_[a],
+                                           XpbdCoefficients::make(at.compliance, at.damping, invH),
+                                           q.pos - start[at.particle].pos);
+      attachmentLambda_[a] += dLambda;
+      q.pos += q.w * dLambda;
+    }
+  }
+  if (!colliderContacts_.empty()) {
+    StageTimer t(times, Stage::Contact, timed);
+    for (std::size_t c = 0; c < colliderContacts_.size(); ++c) {
+      const ColliderContact& con = colliderContacts_[c];
+      const Collider& collider = colliders_[con.collider];
+      Point& q = pred[con.particle];
+      const ContactCorrection r = solveColliderContact(
+          q, start[con.particle].pos, closestSurface(collider, q.pos), con.particleRadius, collider,
+          contactNormalLambda_[c], contactFrictionLambda_[c], XpbdCoefficients::make(collider.compliance, 0.0f, invH));
+      contactNormalLambda_[c] += r.dLambdaNormal;
+      contactFrictionLambda_[c] += r.dLambdaFriction;
+      q.pos += r.dp;
+    }
+  }
+  if (!fingertipContacts_.empty()) {
+    StageTimer t(times, Stage::Fingertip, timed);
+    for (std::size_t c = 0; c < fingertipContacts_.size(); ++c) {
+      const FingertipContact& con = fingertipContacts_[c];
+      const Fingertip& f = fingertips_[con.fingertip];
+      Point& q = pred[con.particle];
+      const Correction<1> r = solveFingertipContact(q, f.center, f.radius, fingertipLambda_[c],
+                                                    XpbdCoefficients::make(f.compliance, 0.0f, invH));
+      fingertipLambda_[c] += r.dLambda;
+      q.pos += r.dp[0];
+    }
+  }
+}
+
+void World::finalise(float h) {
+  StageTimer timer(report_.times, Stage::Finalise, settings_.timeStages);
+  const float invH = 1.0f / h;
+  for (BodyId id = 0; id < bodies_.size(); ++id) {
+    const Body& b = bodies_[id];
+    if (b.state != BodyState::Active) continue;
+    const Index end = b.firstParticle + b.particleCount;
+    bool finite = true;
+    for (Index i = b.firstParticle; i < end; ++i) finite &= isFinite(particles_.p[i].pos);
+    if (!finite) {
+      containNonFinite(id);
+      continue;
+    }
+    for (Index i = b.firstParticle; i < end; ++i) {  // Algorithm 1, lines 19-20
+      particles_.v[i] = (particles_.p[i].pos - particles_.x[i].pos) * invH;
+      particles_.x[i].pos = particles_.p[i].pos;
+    }
+  }
+}
+
+void World::containNonFinite(BodyId id) {
+  Body& b = bodies_[id];
+  Index first = b.firstParticle;
+  while (isFinite(particles_.p[first].pos)) ++first;
+  bool lastStateFinite = true;
+  for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i)
+    lastStateFinite &= isFinite(particles_.x[i].pos) && isFinite(particles_.v[i]);
+  const std::string what = fmt::format("body {}: non-finite position of particle {} in step {}", id,
+                                       first - b.firstParticle, stepCount_);
+  if (settings_.onNan == NanPolicy::Freeze && lastStateFinite) {
+    for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
+      particles_.p[i].pos = particles_.x[i].pos;
+      particles_.v[i].setZero();
+    }
+    b.state = BodyState::Frozen;
+    events_.push_back({stepCount_, id, what + "; frozen at its last finite state"});
+  } else {
+    resetBody(id);
+    events_.push_back({stepCount_, id, what + "; reset to its initial pose"});
+  }
+}
+
+double World::volume(BodyId id) const {
+  const Body& b = bodies_.at(id);
+  const Point* x = particles_.x.data() + b.firstParticle;
+  double sum = 0.0;
+  for (const Tet& t : b.model->tets)
+    sum += signedTetVolume<double>(x[t[0]].pos.cast<double>(), x[t[1]].pos.cast<double>(),
+                                   x[t[2]].pos.cast<double>(), x[t[3]].pos.cast<double>());
+  return sum;
+}
+
+double World::volumeLoss(BodyId id) const {
+  const double v0 = bodies_.at(id).model->restVolume;
+  return v0 > 0.0 ? (v0 - volume(id)) / v0 : 0.0;
+}
+
+std::vector<Vec3> World::particleConstraintForces(BodyId id) const {
+  const Body& b = bodies_.at(id);
+  const BodyModel& m = *b.model;
+  const float h = substepSize(), invH2 = 1.0f / (h * h);
+  const Point* x = particles_.x.data() + b.firstParticle;
+  std::vector<Vec3> f(b.particleCount, Vec3::Zero());
+  auto add = [&](const auto& idx, const auto& grad, float lambda) {
+    for (std::size_t k = 0; k < std::size(idx); ++k) f[idx[k]] += lambda * invH2 * grad[k];
+  };
+  for (std::size_t c = 0; c < m.distance.size(); ++c) {
+    const auto& con = m.distance[c];
+    const Vec3 n = evalDistance(x[con.i[0]].pos, x[con.i[1]].pos, con.restLength).n;
+    add(con.i, std::array<Vec3, 2>{n, -n}, b.distanceLambda[c]);
+  }
+  for (std::size_t c = 0; c < m.volume.size(); ++c) {
+    const auto& con = m.volume[c];
+    add(con.i, evalVolume(x[con.i[0]].pos, x[con.i[1]].pos, x[con.i[2]].pos, x[con.i[3]].pos, con.restVolume).grad,
+        b.volumeLambda[c]);
+  }
+  for (std::size_t c = 0; c < m.strain.size(); ++c) {
+    const auto& con = m.strain[c];
+    for (int k = 0; k < kStrainComponents; ++k)
+      add(con.i,
+          evalStrainComponent(x[con.i[0]].pos, x[con.i[1]].pos, x[con.i[2]].pos, x[con.i[3]].pos, con.invRestShape, k)
+              .grad,
+          b.strainLambda[c][k]);
+  }
+  for (std::size_t c = 0; c < m.bend.size(); ++c) {
+    const auto& con = m.bend[c];
+    add(con.i, evalBend(x[con.i[0]].pos, x[con.i[1]].pos, x[con.i[2]].pos, x[con.i[3]].pos, con.restAngle).grad,
+        b.bendLambda[c]);
+  }
+  for (std::size_t i = 0; i < b.shapeMatchLambda.size(); ++i) f[i] += b.shapeMatchLambda[i] * invH2;
+
+  auto local = [&](Index particle) -> Vec3* {
+    return particle >= b.firstParticle && particle < b.firstParticle + b.particleCount ? &f[particle - b.firstParticle]
+                                                                                        : nullptr;
+  };
+  for (std::size_t a = 0; a < attachments_.size(); ++a)
+    if (Vec3* fi = attachments_[a].particle == kNoParticle ? nullptr : local(attachments_[a].particle))
+      *fi += attachmentLambda_[a] * invH2;
+  for (std::size_t c = 0; c < colliderContacts_.size(); ++c)
+    if (Vec3* fi = local(colliderContacts_[c].particle)) {
+      const Vec3 n = closestSurface(colliders_[colliderContacts_[c].collider], particles_.x[colliderContacts_[c].particle].pos).normal;
+      *fi += (contactNormalLambda_[c] * n + contactFrictionLambda_[c]) * invH2;
+    }
+  for (std::size_t c = 0; c < fingertipContacts_.size(); ++c)
+    if (Vec3* fi = local(fingertipContacts_[c].particle)) {
+      const Fingertip& tip = fingertips_[fingertipContacts_[c].fingertip];
+      *fi += fingertipLambda_[c] * invH2 * evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, tip.center, tip.radius).n;
+    }
+  return f;
+}
+
+}  // namespace vrd
