@@ -77,44 +77,47 @@ struct StrainCorrection {
 /// B = sum_k w_k a_k a_k^T, the correction of component (i, j) changes F by a rank-1 term and the
 /// denominator of eq. 1 is sum_k w_k |grad_k S_ij|^2 = B_ii |f_j|^2 + B_jj |f_i|^2 + 2 B_ij S_ij.
 /// The particles' corrections are gathered in U and applied once: dp_k = w_k U a_k.
-inline StrainCorrection solveStrain(const Point (&p)[4], const Mat3& invRestShape,
-                                    const StrainLambda& lambda, const XpbdCoefficients& stretch,
-                                    const XpbdCoefficients& shear, const Vec3* disp = nullptr) {
+/// (Columns are kept as separate 3-vectors: Eigen's partly vectorised 3x3 ops stall on
+/// store-to-load forwarding here.)
+inline StrainCorrection solveStrain(const Point (&p)[4], const Mat3& invRestShape, const StrainLambda& lambda,
+                                    const XpbdCoefficients& stretch, const XpbdCoefficients& shear,
+                                    const Vec3* disp = nullptr) {
   const auto a = strainWeights(invRestShape);
-  Mat3 F = deformationGradient(p[0].pos, p[1].pos, p[2].pos, p[3].pos, invRestShape);
-  Mat3 B = p[0].w * a[0] * a[0].transpose();
-  for (int k = 1; k < 4; ++k) B.noalias() += p[k].w * a[k] * a[k].transpose();
-  // Displacement gradient since the start of the substep, for damping: grad C . disp = f_j.D_i + f_i.D_j.
-  Mat3 D = Mat3::Zero();
-  if (disp)
-    for (int k = 0; k < 4; ++k) D.noalias() += disp[k] * a[k].transpose();
+  Vec3 f[3], D[3], U[3];  // columns of F, of the displacement gradient (damping) and of U
+  float B[3][3];
+  for (int i = 0; i < 3; ++i) {
+    f[i] = a[0][i] * p[0].pos + a[1][i] * p[1].pos + a[2][i] * p[2].pos + a[3][i] * p[3].pos;
+    D[i] = disp ? Vec3(a[0][i] * disp[0] + a[1][i] * disp[1] + a[2][i] * disp[2] + a[3][i] * disp[3]) : Vec3::Zero();
+    U[i].setZero();
+    for (int j = i; j < 3; ++j)
+      B[i][j] = B[j][i] = p[0].w * a[0][i] * a[0][j] + p[1].w * a[1][i] * a[1][j] + p[2].w * a[2][i] * a[2][j] +
+                          p[3].w * a[3][i] * a[3][j];
+  }
 
   StrainCorrection out;
-  Mat3 U = Mat3::Zero();
   for (int c = 0; c < kStrainComponents; ++c) {
     const int i = kStrainAxes[c][0], j = kStrainAxes[c][1];
-    const Vec3 fi = F.col(i), fj = F.col(j);
-    const float Sij = fi.dot(fj);
-    float dLambda;
-    Mat3 dF;
+    const float Sij = f[i].dot(f[j]);
+    Vec3 gi, gj;  // changes of U's columns i and j
     if (i == j) {
-      dLambda = deltaLambda(Sij - 1.0f, lambda[c], 4.0f * B(i, i) * Sij, stretch, 2.0f * fi.dot(D.col(i)));
-      const Vec3 g = 2.0f * dLambda * fi;
-      U.col(i) += g;
-      dF.noalias() = g * B.row(i);
+      out.dLambda[c] = deltaLambda(Sij - 1.0f, lambda[c], 4.0f * B[i][i] * Sij, stretch, 2.0f * f[i].dot(D[i]));
+      gi = 2.0f * out.dLambda[c] * f[i];
+      gj.setZero();
     } else {
-      const float gradMinvGrad = B(i, i) * fj.squaredNorm() + B(j, j) * fi.squaredNorm() + 2.0f * B(i, j) * Sij;
-      dLambda = deltaLambda(Sij, lambda[c], gradMinvGrad, shear, fj.dot(D.col(i)) + fi.dot(D.col(j)));
-      const Vec3 gi = dLambda * fj, gj = dLambda * fi;
-      U.col(i) += gi;
-      U.col(j) += gj;
-      dF.noalias() = gi * B.row(i) + gj * B.row(j);
+      const float gradMinvGrad = B[i][i] * f[j].squaredNorm() + B[j][j] * f[i].squaredNorm() + 2.0f * B[i][j] * Sij;
+      out.dLambda[c] = deltaLambda(Sij, lambda[c], gradMinvGrad, shear, f[j].dot(D[i]) + f[i].dot(D[j]));
+      gi = out.dLambda[c] * f[j];
+      gj = out.dLambda[c] * f[i];
     }
-    F += dF;
-    if (disp) D += dF;
-    out.dLambda[c] = dLambda;
+    U[i] += gi;
+    U[j] += gj;
+    for (int m = 0; m < 3; ++m) {  // F += gi B_i. + gj B_j. (the rank-1 change of F)
+      const Vec3 dF = B[i][m] * gi + B[j][m] * gj;
+      f[m] += dF;
+      if (disp) D[m] += dF;
+    }
   }
-  for (int k = 0; k < 4; ++k) out.dp[k] = p[k].w * (U * a[k]);
+  for (int k = 0; k < 4; ++k) out.dp[k] = p[k].w * (a[k][0] * U[0] + a[k][1] * U[1] + a[k][2] * U[2]);
   return out;
 }
 
