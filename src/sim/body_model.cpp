@@ -37,12 +37,18 @@ void validateMaterial(const Material& m) {
       throw Error(fmt::format("material: Poisson ratio must be in [0, 0.5), got {}", e.poissonRatio));
     if (!(std::isfinite(e.density) && e.density > 0.0f))
       throw Error(fmt::format("material: density must be positive, got {}", e.density));
+    if (!finiteNonNegative(e.rayleighDamping))
+      throw Error(fmt::format("material: Rayleigh damping must be finite and >= 0, got {}", e.rayleighDamping));
   }
 }
 
+float dampingTime(const ConstraintMaterial& c) { return c.compliance * c.damping; }
+
 ConstraintDamping dampingOf(const Material& m) {
-  return {m.distance.damping,    m.volume.damping,  m.strainStretch.damping,
-          m.strainShear.damping, m.bending.damping, m.shapeMatching.damping};
+  ConstraintDamping d{dampingTime(m.distance),    dampingTime(m.volume),  dampingTime(m.strainStretch),
+                      dampingTime(m.strainShear), dampingTime(m.bending), dampingTime(m.shapeMatching)};
+  if (m.elastic) d.distance = d.volume = d.strainStretch = d.strainShear = m.elastic->rayleighDamping;
+  return d;
 }
 
 using Edge = std::pair<Index, Index>;

@@ -45,12 +45,12 @@ void scatter(const Index (&idx)[N], const Vec3 (&dp)[N], Point* pred) {
 
 // One Gauss-Seidel sweep over a scalar constraint type: gather, project, scatter.
 template <bool Damped, typename C, typename Solve>
-void sweep(const std::vector<C>& constraints, float* lambda, Point* pred, const Point* start, float beta, float invH,
+void sweep(const std::vector<C>& constraints, float* lambda, Point* pred, const Point* start, float tau, float invH,
            Solve solve) {
   for (std::size_t c = 0; c < constraints.size(); ++c) {
     const C& con = constraints[c];
     const Gathered<std::extent_v<decltype(C::i)>, Damped> g(con.i, pred, start);
-    const auto r = solve(con, g.p, lambda[c], XpbdCoefficients::make(con.compliance, beta, invH), g.displacement());
+    const auto r = solve(con, g.p, lambda[c], XpbdCoefficients::make(con.compliance, tau, invH), g.displacement());
     lambda[c] += r.dLambda;
     scatter(con.i, r.dp, pred);
   }
@@ -58,11 +58,11 @@ void sweep(const std::vector<C>& constraints, float* lambda, Point* pred, const 
 
 template <typename C, typename Solve>
 void sweepScalar(const std::vector<C>& constraints, std::vector<float>& lambda, Point* pred, const Point* start,
-                 float beta, float invH, Solve solve) {
-  if (beta > 0.0f)
-    sweep<true>(constraints, lambda.data(), pred, start, beta, invH, solve);
+                 float tau, float invH, Solve solve) {
+  if (tau > 0.0f)
+    sweep<true>(constraints, lambda.data(), pred, start, tau, invH, solve);
   else
-    sweep<false>(constraints, lambda.data(), pred, start, beta, invH, solve);
+    sweep<false>(constraints, lambda.data(), pred, start, tau, invH, solve);
 }
 
 template <bool Damped>
@@ -80,12 +80,12 @@ void sweepStrain(const std::vector<StrainConstraint>& constraints, StrainLambda*
 }
 
 void sweepShapeMatching(const ShapeMatchModel& sm, Vec3* lambda, Quat& rotation, Point* pred, const Point* start,
-                        float beta, float invH) {
+                        float tau, float invH) {
   const ShapeMatchFrame frame = shapeMatchFrame(pred, sm, rotation);
-  const XpbdCoefficients k = XpbdCoefficients::make(sm.compliance, beta, invH);
+  const XpbdCoefficients k = XpbdCoefficients::make(sm.compliance, tau, invH);
   for (std::size_t i = 0; i < sm.restOffsets.size(); ++i) {
     const Vec3 goal = frame.centroid + frame.rotation * sm.restOffsets[i];
-    const Vec3 disp = beta > 0.0f ? Vec3(pred[i].pos - start[i].pos) : Vec3::Zero();
+    const Vec3 disp = tau > 0.0f ? Vec3(pred[i].pos - start[i].pos) : Vec3::Zero();
     const Vec3 dLambda = solveShapeMatchParticle(pred[i], goal, lambda[i], k, disp);
     lambda[i] += dLambda;
     pred[i].pos += pred[i].w * dLambda;
@@ -158,7 +158,7 @@ AttachmentId World::attach(Index particle, const Vec3& target, float compliance,
   checkCompliance(compliance, "attach");
   if (!((axes.array() == 0.0f) || (axes.array() == 1.0f)).all()) throw Error("attach: axes must be 0 or 1 each");
   if (!(std::isfinite(damping) && damping >= 0.0f)) throw Error("attach: damping must be finite and >= 0");
-  const Attachment a{particle, target, target, axes, compliance, damping};
+  const Attachment a{particle, target, target, axes, compliance, compliance * damping};
   for (std::size_t id = 0; id < attachments_.size(); ++id)
     if (attachments_[id].particle == kNoParticle) {
       attachments_[id] = a;
@@ -311,18 +311,18 @@ void World::solveIteration(float h) {
                   [](const DistanceConstraint& c, const Point(&q)[2], float l, const XpbdCoefficients& k,
                      const Vec3* d) { return solveDistance(q, c.restLength, l, k, d); });
     }
-    if (!m.volume.empty()) {
-      StageTimer t(times, Stage::Volume, timed);
-      sweepScalar(m.volume, b.volumeLambda, p, x, m.damping.volume, invH,
-                  [](const VolumeConstraint& c, const Point(&q)[4], float l, const XpbdCoefficients& k,
-                     const Vec3* d) { return solveVolume(q, c.restVolume, l, k, d); });
-    }
     if (!m.strain.empty()) {
       StageTimer t(times, Stage::Strain, timed);
       if (m.damping.strainStretch > 0.0f || m.damping.strainShear > 0.0f)
         sweepStrain<true>(m.strain, b.strainLambda.data(), p, x, m.damping, invH);
       else
         sweepStrain<false>(m.strain, b.strainLambda.data(), p, x, m.damping, invH);
+    }
+    if (!m.volume.empty()) {
+      StageTimer t(times, Stage::Volume, timed);
+      sweepScalar(m.volume, b.volumeLambda, p, x, m.damping.volume, invH,
+                  [](const VolumeConstraint& c, const Point(&q)[4], float l, const XpbdCoefficients& k,
+                     const Vec3* d) { return solveVolume(q, c.restVolume, l, k, d); });
     }
     if (!m.bend.empty()) {
       StageTimer t(times, Stage::Bend, timed);
@@ -345,7 +345,7 @@ void World::solveIteration(float h) {
       if (at.particle == kNoParticle) continue;
       Point& q = pred[at.particle];
       const Vec3 dLambda = solveAttachment(q, at.target, at.axes, attachmentLambda_[a],
-                                           XpbdCoefficients::make(at.compliance, at.damping, invH),
+                                           XpbdCoefficients::make(at.compliance, at.dampingTime, invH),
                                            q.pos - start[at.particle].pos);
       attachmentLambda_[a] += dLambda;
       q.pos += q.w * dLambda;

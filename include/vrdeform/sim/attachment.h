@@ -14,7 +14,7 @@ struct Attachment {
   Vec3 goal;          ///< where t arrives at the end of the step; substeps move t there linearly
   Vec3 axes;          ///< 1 for each held world axis, 0 for free ones
   float compliance;   ///< alpha (m/N)
-  float damping;      ///< beta (s)
+  float dampingTime;  ///< tau = alpha * beta (s), see xpbd.h
 };
 
 /// Eqs. 1 and 3 for the vector constraint: returns dLambda; the particle moves by w dLambda.

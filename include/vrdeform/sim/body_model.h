@@ -27,7 +27,7 @@ struct ConstraintSet {
   static ConstraintSet edgesAndVolume() { return {true, true, false, false}; }
 };
 
-/// Rayleigh damping beta (s) of each constraint type.
+/// Damping time tau = alpha * beta (s) of each constraint type; gamma = tau / h (xpbd.h).
 struct ConstraintDamping {
   float distance = 0, volume = 0, strainStretch = 0, strainShear = 0, bend = 0, shapeMatching = 0;
 };

@@ -6,8 +6,9 @@
 
 namespace vrd {
 
-/// Compliance alpha (inverse stiffness, in the constraint's units) and Rayleigh damping beta (s)
-/// of one constraint type.
+/// Compliance alpha (inverse stiffness, in the constraint's units) and damping beta (eq. 5, in
+/// the units of 1/alpha times seconds) of one constraint type. The solver damps with the time
+/// tau = alpha * beta (see xpbd.h).
 struct ConstraintMaterial {
   float compliance;
   float damping;
@@ -17,9 +18,11 @@ struct ConstraintMaterial {
 /// so that volume + strain constraints reproduce isotropic linear elasticity at small strain, and
 /// lumps particle masses from the density.
 struct ElasticModuli {
-  float youngsModulus;  ///< E (Pa)
-  float poissonRatio;   ///< nu, in [0, 0.5)
-  float density;        ///< rho (kg/m^3)
+  float youngsModulus;          ///< E (Pa)
+  float poissonRatio;           ///< nu, in [0, 0.5)
+  float density;                ///< rho (kg/m^3)
+  float rayleighDamping = 0.0f; ///< stiffness-proportional damping time tau (s); a mode of angular
+                                ///< frequency w gets damping ratio w tau / 2
 };
 
 struct Material {
@@ -33,7 +36,8 @@ struct Material {
   ConstraintMaterial shapeMatching{0.3f, 0.03f};  ///< p_i - g_i (eq. 28), per unit mass
   ConstraintMaterial bending{0.3f, 0.03f};        ///< dihedral angle (eq. 24)
 
-  std::optional<ElasticModuli> elastic;  ///< overrides particleMass and the distance, volume and strain compliances
+  /// Overrides particleMass and the distance, volume and strain compliances and damping.
+  std::optional<ElasticModuli> elastic;
 
   float particleRadius = 0.0f;  ///< particles keep this distance from colliders (m); cloth thickness
 };

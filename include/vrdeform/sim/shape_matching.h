@@ -50,12 +50,12 @@ inline ShapeMatchFrame shapeMatchFrame(const Point* p, const ShapeMatchModel& mo
 }
 
 /// Eq. 28 for one particle: the change of its vector multiplier; its correction is w dLambda.
-/// `k` holds alpha/h^2 and alpha*beta/h of a unit-mass particle; `disp` its motion in the substep.
+/// `k` holds alpha/h^2 of a unit-mass particle and tau/h; `disp` is the particle's motion in the substep.
 inline Vec3 solveShapeMatchParticle(const Point& p, const Vec3& goal, const Vec3& lambda, const XpbdCoefficients& k,
                                     const Vec3& disp = Vec3::Zero()) {
   if (p.w == 0.0f) return Vec3::Zero();
-  const float alphaTilde = k.alphaTilde * p.w, gamma = k.gamma * p.w;
-  return (goal - p.pos - alphaTilde * lambda - gamma * disp) / ((1.0f + gamma) * p.w + alphaTilde);
+  const float alphaTilde = k.alphaTilde * p.w;  // alpha_i = alpha / m_i
+  return (goal - p.pos - alphaTilde * lambda - k.gamma * disp) / ((1.0f + k.gamma) * p.w + alphaTilde);
 }
 
 }  // namespace vrd

@@ -139,7 +139,7 @@ inline StrainCorrection solveStrainReference(const Point (&p)[4], const Mat3& in
     float gradMinvGrad = 0.0f, gradDotDisp = 0.0f;
     for (int k = 0; k < 4; ++k) {
       gradMinvGrad += p[k].w * e.grad[k].squaredNorm();
-      gradDotDisp += e.grad[k].dot(d[k]);
+      if (disp) gradDotDisp += e.grad[k].dot(d[k]);
     }
     out.dLambda[c] = deltaLambda(e.C, lambda[c], gradMinvGrad, isStretchComponent(c) ? stretch : shear, gradDotDisp);
     for (int k = 0; k < 4; ++k) {

@@ -62,7 +62,7 @@ public:
   // --- Attachments -----------------------------------------------------------------------------
   /// Holds a particle at `target` along the world axes set in `axes` (1 = held).
   AttachmentId attach(Index particle, const Vec3& target, float compliance = 0.0f, const Vec3& axes = Vec3::Ones(),
-                      float damping = 0.0f);
+                      float damping = 0.0f);  // damping: beta of eq. 5; damps with tau = compliance * beta
   /// Moves an attachment's target to `goal` over the next step.
   void moveAttachment(AttachmentId id, const Vec3& goal);
   void detach(AttachmentId id);

@@ -6,13 +6,18 @@
 namespace vrd {
 
 /// Compliance and damping of one constraint for one (sub)step of size h.
+///
+/// Damping is given as a time tau = alpha * beta (s): with the damping beta of eq. 5, XPBD16 eq. 26
+/// has gamma = alphaTilde * betaTilde / h = alpha * beta / h = tau / h. tau is the Rayleigh
+/// (stiffness-proportional) damping time: the damping force is tau times the rate of change of the
+/// elastic force, whatever units the constraint's compliance has.
 struct XpbdCoefficients {
   float alphaTilde;  ///< eq. 2: alpha / h^2
-  float gamma;       ///< Rayleigh damping, XPBD16 eq. 26: alphaTilde * betaTilde / h = alpha * beta / h
+  float gamma;       ///< tau / h
 
   /// `invH` = 1/h, so that loops over many constraints multiply instead of divide.
-  static XpbdCoefficients make(float compliance, float damping, float invH) {
-    return {compliance * invH * invH, compliance * damping * invH};
+  static XpbdCoefficients make(float compliance, float dampingTime, float invH) {
+    return {compliance * invH * invH, dampingTime * invH};
   }
 };
 
