@@ -98,7 +98,7 @@ struct BlockOnGround {
   BlockOnGround() : world(settings()) {
     Material m;
     m.elastic = ElasticModuli{2e4f, 0.3f, 1000.0f};
-    const TetMesh mesh = makeBoxTets(Vec3(-0.05f, 0.0f, -0.05f), Vec3(0.1f, 0.1f, 0.1f), 3, 3, 3);
+    const TetMesh mesh = makeBoxTets(Vec3(-0.05f, 0.0f, -0.05f), Vec3(0.1f, 0.1f, 0.1f), 4, 4, 4);  // a vertex at the top centre
     body = world.addBody(makeSoftBody(mesh, m, {false, true, true, false}));
     world.addCollider(Collider::plane(Vec3::UnitY()));
     weight = 1000.0f * 1e-3f * kG;  // rho V g

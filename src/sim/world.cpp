@@ -13,6 +13,7 @@ namespace vrd {
 namespace {
 
 constexpr Index kNoParticle = std::numeric_limits<Index>::max();
+constexpr float kFingertipSkin = 0.05f;  // fingertip contact candidates reach 5% beyond the radius
 
 void checkFinite(const Vec3& v, const char* what) {
   if (!isFinite(v)) throw Error(fmt::format("{}: non-finite value ({}, {}, {})", what, v.x(), v.y(), v.z()));
@@ -215,8 +216,10 @@ Vec3 World::fingertipForce(FingertipId id) const {
 }
 
 std::size_t World::fingertipContactCount(FingertipId id) const {
-  return std::size_t(std::count_if(fingertipContacts_.begin(), fingertipContacts_.end(),
-                                   [id](const FingertipContact& c) { return c.fingertip == id; }));
+  std::size_t count = 0;
+  for (std::size_t c = 0; c < fingertipContacts_.size(); ++c)
+    count += fingertipContacts_[c].fingertip == id && fingertipLambda_[c] > 0.0f;
+  return count;
 }
 
 std::vector<SimEvent> World::takeEvents() { return std::exchange(events_, {}); }
@@ -267,14 +270,17 @@ void World::detectContacts(float /*h*/) {
     for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
       const Point& p = particles_.p[i];
       if (p.w == 0.0f) continue;
-      // Anything the particle could reach in this substep: its predicted motion as margin.
-      const float margin = radius + (p.pos - particles_.x[i].pos).norm();
+      // Anything the particle could reach in this substep: its predicted motion as margin. The
+      // contacts are inequalities, so candidates that stay clear cost a check and do nothing.
+      const float motion = (p.pos - particles_.x[i].pos).norm();
       for (Index c = 0; c < colliders_.size(); ++c)
-        if (closestSurface(colliders_[c], p.pos).distance < margin) colliderContacts_.push_back({i, c, radius});
-      // Eq. 36: the fingertip's contact set N(r) from the predicted positions.
-      for (Index f = 0; f < fingertips_.size(); ++f)
-        if ((p.pos - fingertips_[f].center).squaredNorm() <= fingertips_[f].radius * fingertips_[f].radius)
-          fingertipContacts_.push_back({i, f});
+        if (closestSurface(colliders_[c], p.pos).distance < radius + motion) colliderContacts_.push_back({i, c, radius});
+      // Eq. 36: N(r) from the predicted positions, widened by the same margin plus a skin, so that
+      // a particle resting on the fingertip is not dropped when its prediction lands just outside.
+      for (Index f = 0; f < fingertips_.size(); ++f) {
+        const float reach = fingertips_[f].radius * (1.0f + kFingertipSkin) + motion;
+        if ((p.pos - fingertips_[f].center).squaredNorm() <= reach * reach) fingertipContacts_.push_back({i, f});
+      }
     }
   }
 }

@@ -81,7 +81,7 @@ public:
   std::size_t fingertipCount() const { return fingertips_.size(); }
   /// Total force the fingertip applied to the bodies in the last substep (N).
   Vec3 fingertipForce(FingertipId id) const;
-  /// Number of particles in the fingertip's contact set N(r) in the last substep.
+  /// Number of particles the fingertip pushed in the last substep (contacts with lambda > 0).
   std::size_t fingertipContactCount(FingertipId id) const;
 
   const std::vector<ColliderContact>& colliderContacts() const { return colliderContacts_; }
