@@ -409,9 +409,8 @@ void World::containNonFinite(BodyId id) {
   Body& b = bodies_[id];
   Index first = b.firstParticle;
   while (isFinite(particles_.p[first].pos)) ++first;
-  bool lastStateFinite = true;
-  for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i)
-    lastStateFinite &= isFinite(particles_.x[i].pos) && isFinite(particles_.v[i]);
+  bool lastStateFinite = true;  // the committed positions; velocities are zeroed anyway
+  for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) lastStateFinite &= isFinite(particles_.x[i].pos);
   const std::string what = fmt::format("body {}: non-finite position of particle {} in step {}", id,
                                        first - b.firstParticle, stepCount_);
   if (settings_.onNan == NanPolicy::Freeze && lastStateFinite) {
