@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "vrdeform/error.h"
+#include "vrdeform/sim/lane_batches.h"
 
 namespace vrd {
 namespace {
@@ -72,6 +73,35 @@ void checkAll(const char* what, const std::vector<C>& items, std::size_t particl
   for (std::size_t c = 0; c < items.size(); ++c) checkItem(what, c, items[c].i, particles, items[c].compliance);
 }
 
+template <typename C>
+std::vector<std::array<Index, std::extent_v<decltype(C::i)>>> particlesOf(const std::vector<C>& constraints) {
+  std::vector<std::array<Index, std::extent_v<decltype(C::i)>>> out(constraints.size());
+  for (std::size_t c = 0; c < constraints.size(); ++c) std::copy(std::begin(constraints[c].i), std::end(constraints[c].i), out[c].begin());
+  return out;
+}
+
+template <typename T>
+std::vector<T> permuted(const std::vector<T>& items, const std::vector<Index>& order) {
+  std::vector<T> out;
+  out.reserve(items.size());
+  for (Index k : order) out.push_back(items[k]);
+  return out;
+}
+
+// Puts the distance constraints in lane order.
+void batchDistances(BodyModel& model) {
+  const LaneOrder order = orderForLanes(particlesOf(model.distance));
+  model.distance = permuted(model.distance, order.order);
+  model.batchedDistance = order.batched;
+}
+
+template <typename C>
+void checkBatches(const char* what, const std::vector<C>& constraints, std::size_t batched) {
+  if (!lanesIndependent(particlesOf(constraints), batched))
+    throw Error(fmt::format("{} constraints: the first {} are not in groups of {} that share no particle", what,
+                            batched, kLanes));
+}
+
 }  // namespace
 
 void addDistanceConstraint(BodyModel& model, Index a, Index b, float compliance) {
@@ -109,16 +139,17 @@ std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Materia
   validateMaterial(material);
   auto model = std::make_shared<BodyModel>();
   model->restPositions = mesh.vertices;
-  model->tets = mesh.tets;
+  const LaneOrder tetOrder = orderForLanes(mesh.tets);
+  model->tets = permuted(mesh.tets, tetOrder.order);
   model->damping = dampingOf(material);
   model->particleRadius = material.particleRadius;
 
   const std::size_t n = mesh.vertices.size();
-  std::vector<double> restVolume(mesh.tets.size());
+  std::vector<double> restVolume(model->tets.size());
   std::vector<double> lumpedMass(n, 0.0);
   std::vector<char> used(n, 0);
-  for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
-    const Tet& tet = mesh.tets[t];
+  for (std::size_t t = 0; t < model->tets.size(); ++t) {
+    const Tet& tet = model->tets[t];
     const Vec3T<double> p0 = mesh.vertices[tet[0]].cast<double>(), p1 = mesh.vertices[tet[1]].cast<double>(),
                         p2 = mesh.vertices[tet[2]].cast<double>(), p3 = mesh.vertices[tet[3]].cast<double>();
     restVolume[t] = signedTetVolume(p0, p1, p2, p3);
@@ -144,9 +175,9 @@ std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Materia
 
   if (constraints.edges) {
     std::map<Edge, double> edgeVolume;  // each tet lends a sixth of its volume to each of its edges
-    for (std::size_t t = 0; t < mesh.tets.size(); ++t)
+    for (std::size_t t = 0; t < model->tets.size(); ++t)
       for (int a = 0; a < 4; ++a)
-        for (int b = a + 1; b < 4; ++b) edgeVolume[sortedEdge(mesh.tets[t][a], mesh.tets[t][b])] += restVolume[t] / 6.0;
+        for (int b = a + 1; b < 4; ++b) edgeVolume[sortedEdge(model->tets[t][a], model->tets[t][b])] += restVolume[t] / 6.0;
     for (const auto& [edge, volume] : edgeVolume) {
       const double length = (mesh.vertices[edge.first] - mesh.vertices[edge.second]).cast<double>().norm();
       const float compliance = material.elastic
@@ -156,15 +187,15 @@ std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Materia
     }
   }
   if (constraints.volume && !(material.elastic && lameLambda <= 0.0)) {  // nu = 0: no bulk term
-    for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
-      const Tet& tet = mesh.tets[t];
+    for (std::size_t t = 0; t < model->tets.size(); ++t) {
+      const Tet& tet = model->tets[t];
       const float compliance = material.elastic ? float(restVolume[t] / lameLambda) : material.volume.compliance;
       model->volume.push_back({{tet[0], tet[1], tet[2], tet[3]}, float(restVolume[t]), compliance});
     }
   }
   if (constraints.strain) {
-    for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
-      const Tet& tet = mesh.tets[t];
+    for (std::size_t t = 0; t < model->tets.size(); ++t) {
+      const Tet& tet = model->tets[t];
       Mat3T<double> rest;
       const Vec3T<double> p0 = mesh.vertices[tet[0]].cast<double>();
       for (int k = 0; k < 3; ++k) rest.col(k) = mesh.vertices[tet[k + 1]].cast<double>() - p0;
@@ -177,6 +208,9 @@ std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Materia
     }
   }
   if (constraints.shapeMatching) model->shapeMatching = makeShapeMatchModel(*model, material.shapeMatching.compliance);
+  batchDistances(*model);
+  model->batchedVolume = model->volume.empty() ? 0 : tetOrder.batched;
+  model->batchedStrain = model->strain.empty() ? 0 : tetOrder.batched;
   return model;
 }
 
@@ -207,6 +241,7 @@ std::shared_ptr<const BodyModel> makeCloth(const TriMesh& mesh, const Material& 
       model->bend.push_back(b);
     }
   }
+  batchDistances(*model);
   std::vector<char> used(mesh.vertices.size(), 0);
   for (const Triangle& t : mesh.triangles)
     for (Index v : t) used[v] = 1;
@@ -257,6 +292,9 @@ void validateModel(const BodyModel& model) {
     if (!finiteNonNegative(sm->compliance)) throw Error("shape matching compliance must be finite and >= 0");
     if (!(sm->totalMass > 0.0f)) throw Error("shape matching needs a positive total mass");
   }
+  checkBatches("distance", model.distance, model.batchedDistance);
+  checkBatches("volume", model.volume, model.batchedVolume);
+  checkBatches("strain", model.strain, model.batchedStrain);
   const ConstraintDamping& d = model.damping;
   for (float beta : {d.distance, d.volume, d.strainStretch, d.strainShear, d.bend, d.shapeMatching})
     if (!finiteNonNegative(beta)) throw Error(fmt::format("damping must be finite and >= 0, got {}", beta));

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "vrdeform/error.h"
+#include "sweeps.h"
 
 namespace vrd {
 namespace {
@@ -24,59 +25,16 @@ void checkCompliance(float compliance, const char* what) {
     throw Error(fmt::format("{}: compliance must be finite and >= 0, got {}", what, compliance));
 }
 
-// Loads the constraint's particles and, when damped, their motion since the start of the substep.
-template <std::size_t N, bool Damped>
-struct Gathered {
-  Point p[N];
-  Vec3 disp[N];
-
-  Gathered(const Index (&idx)[N], const Point* pred, const Point* start) {
-    for (std::size_t k = 0; k < N; ++k) {
-      p[k] = pred[idx[k]];
-      if constexpr (Damped) disp[k] = p[k].pos - start[idx[k]].pos;
-    }
-  }
-  const Vec3* displacement() const { return Damped ? disp : nullptr; }
-};
-
-template <std::size_t N>
-void scatter(const Index (&idx)[N], const Vec3 (&dp)[N], Point* pred) {
-  for (std::size_t k = 0; k < N; ++k) pred[idx[k]].pos += dp[k];
-}
-
-// One Gauss-Seidel sweep over a scalar constraint type: gather, project, scatter.
-template <bool Damped, typename C, typename Solve>
-void sweep(const std::vector<C>& constraints, float* lambda, Point* pred, const Point* start, float tau, float invH,
-           Solve solve) {
-  for (std::size_t c = 0; c < constraints.size(); ++c) {
-    const C& con = constraints[c];
-    const Gathered<std::extent_v<decltype(C::i)>, Damped> g(con.i, pred, start);
-    const auto r = solve(con, g.p, lambda[c], XpbdCoefficients::make(con.compliance, tau, invH), g.displacement());
-    lambda[c] += r.dLambda;
-    scatter(con.i, r.dp, pred);
-  }
-}
-
-template <typename C, typename Solve>
-void sweepScalar(const std::vector<C>& constraints, std::vector<float>& lambda, Point* pred, const Point* start,
-                 float tau, float invH, Solve solve) {
-  if (tau > 0.0f)
-    sweep<true>(constraints, lambda.data(), pred, start, tau, invH, solve);
-  else
-    sweep<false>(constraints, lambda.data(), pred, start, tau, invH, solve);
-}
-
+// One scalar sweep over the bending constraints (not batched: bending is a cloth's lighter part).
 template <bool Damped>
-void sweepStrain(const std::vector<StrainConstraint>& constraints, StrainLambda* lambda, Point* pred,
-                 const Point* start, const ConstraintDamping& damping, float invH) {
+void sweepBend(const std::vector<BendConstraint>& constraints, float* lambda, float tau, const sweeps::Range& r) {
   for (std::size_t c = 0; c < constraints.size(); ++c) {
-    const StrainConstraint& con = constraints[c];
-    const Gathered<4, Damped> g(con.i, pred, start);
-    const StrainCorrection r = solveStrain(
-        g.p, con.invRestShape, lambda[c], XpbdCoefficients::make(con.stretchCompliance, damping.strainStretch, invH),
-        XpbdCoefficients::make(con.shearCompliance, damping.strainShear, invH), g.displacement());
-    for (int k = 0; k < kStrainComponents; ++k) lambda[c][k] += r.dLambda[k];
-    scatter(con.i, r.dp, pred);
+    const BendConstraint& con = constraints[c];
+    const sweeps::Gathered<float, 4, Damped> g(&con, r.pred, r.start);
+    const auto out = solveBend(g.x, g.w, con.restAngle, lambda[c], XpbdCoefficients::make(con.compliance, tau, r.invH),
+                               g.displacement());
+    lambda[c] += out.dLambda;
+    g.scatter(out.dp, r.pred);
   }
 }
 
@@ -309,37 +267,45 @@ void World::solveIteration(float h) {
   for (Body& b : bodies_) {
     if (b.state != BodyState::Active) continue;
     const BodyModel& m = *b.model;
-    Point* p = pred + b.firstParticle;
-    const Point* x = start + b.firstParticle;
+    const ConstraintDamping& tau = m.damping;
+    const sweeps::Range r{pred + b.firstParticle, start + b.firstParticle, invH};
+    const bool simd = settings_.simd;
     if (!m.distance.empty()) {
       StageTimer t(times, Stage::Distance, timed);
-      sweepScalar(m.distance, b.distanceLambda, p, x, m.damping.distance, invH,
-                  [](const DistanceConstraint& c, const Point(&q)[2], float l, const XpbdCoefficients& k,
-                     const Vec3* d) { return solveDistance(q, c.restLength, l, k, d); });
+      sweeps::widths(simd, m.batchedDistance, m.distance.size(), tau.distance > 0.0f,
+                     [&](auto damped, auto width, std::size_t begin, std::size_t end) {
+                       sweeps::distance<decltype(width), damped>(m.distance.data(), begin, end, b.distanceLambda.data(),
+                                                                 tau.distance, r);
+                     });
     }
+    // Strain before volume: S = F^T F cannot tell a tet from its mirror image, so the signed
+    // volume constraint gets the last word on orientation.
     if (!m.strain.empty()) {
       StageTimer t(times, Stage::Strain, timed);
-      if (m.damping.strainStretch > 0.0f || m.damping.strainShear > 0.0f)
-        sweepStrain<true>(m.strain, b.strainLambda.data(), p, x, m.damping, invH);
-      else
-        sweepStrain<false>(m.strain, b.strainLambda.data(), p, x, m.damping, invH);
+      sweeps::widths(simd, m.batchedStrain, m.strain.size(), tau.strainStretch > 0.0f || tau.strainShear > 0.0f,
+                     [&](auto damped, auto width, std::size_t begin, std::size_t end) {
+                       sweeps::strain<decltype(width), damped>(m.strain.data(), begin, end, b.strainLambda.data(), tau, r);
+                     });
     }
     if (!m.volume.empty()) {
       StageTimer t(times, Stage::Volume, timed);
-      sweepScalar(m.volume, b.volumeLambda, p, x, m.damping.volume, invH,
-                  [](const VolumeConstraint& c, const Point(&q)[4], float l, const XpbdCoefficients& k,
-                     const Vec3* d) { return solveVolume(q, c.restVolume, l, k, d); });
+      sweeps::widths(simd, m.batchedVolume, m.volume.size(), tau.volume > 0.0f,
+                     [&](auto damped, auto width, std::size_t begin, std::size_t end) {
+                       sweeps::volume<decltype(width), damped>(m.volume.data(), begin, end, b.volumeLambda.data(),
+                                                               tau.volume, r);
+                     });
     }
     if (!m.bend.empty()) {
       StageTimer t(times, Stage::Bend, timed);
-      sweepScalar(m.bend, b.bendLambda, p, x, m.damping.bend, invH,
-                  [](const BendConstraint& c, const Point(&q)[4], float l, const XpbdCoefficients& k,
-                     const Vec3* d) { return solveBend(q, c.restAngle, l, k, d); });
+      if (tau.bend > 0.0f)
+        sweepBend<true>(m.bend, b.bendLambda.data(), tau.bend, r);
+      else
+        sweepBend<false>(m.bend, b.bendLambda.data(), tau.bend, r);
     }
     if (m.shapeMatching) {
       StageTimer t(times, Stage::ShapeMatching, timed);
-      sweepShapeMatching(*m.shapeMatching, b.shapeMatchLambda.data(), b.shapeMatchRotation, p, x,
-                         m.damping.shapeMatching, invH);
+      sweepShapeMatching(*m.shapeMatching, b.shapeMatchLambda.data(), b.shapeMatchRotation, r.pred, r.start,
+                         tau.shapeMatching, invH);
     }
   }
 
@@ -377,7 +343,7 @@ void World::solveIteration(float h) {
       const FingertipContact& con = fingertipContacts_[c];
       const Fingertip& f = fingertips_[con.fingertip];
       Point& q = pred[con.particle];
-      const Correction<1> r = solveFingertipContact(q, f.center, f.radius, fingertipLambda_[c],
+      const Correction<Vec3, 1> r = solveFingertipContact(q, f.center, f.radius, fingertipLambda_[c],
                                                     XpbdCoefficients::make(f.compliance, 0.0f, invH));
       fingertipLambda_[c] += r.dLambda;
       q.pos += r.dp[0];

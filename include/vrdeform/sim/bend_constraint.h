@@ -62,10 +62,10 @@ BendEval<S> evalBend(const Vec3T<S>& p1, const Vec3T<S>& p2, const Vec3T<S>& p3,
 }
 
 /// Eq. 24 projected with eqs. 1 and 3.
-inline Correction<4> solveBend(const Point (&p)[4], float restAngle, float lambda, const XpbdCoefficients& k,
-                               const Vec3* disp = nullptr) {
-  const BendEval<float> e = evalBend(p[0].pos, p[1].pos, p[2].pos, p[3].pos, restAngle);
-  return projectScalar(p, e.C, e.grad, lambda, k, disp);
+inline Correction<Vec3, 4> solveBend(const Vec3 (&x)[4], const float (&w)[4], float restAngle, float lambda,
+                                     const XpbdCoefficients& k, const Vec3* disp = nullptr) {
+  const BendEval<float> e = evalBend(x[0], x[1], x[2], x[3], restAngle);
+  return projectScalar(w, e.C, e.grad, lambda, k, disp);
 }
 
 }  // namespace vrd

@@ -35,7 +35,8 @@ struct ConstraintDamping {
 struct BodyModel {
   std::vector<Vec3> restPositions;  ///< body-local rest positions
   std::vector<float> invMass;       ///< inverse masses (1/kg), 0 = kinematic
-  std::vector<Tet> tets;            ///< the volume elements (soft bodies), for volume and volume loss
+  std::vector<Tet> tets;            ///< the volume elements (soft bodies), in solver order; volume[j] and
+                                    ///< strain[j], when present, belong to tets[j]
   std::vector<Triangle> triangles;  ///< the cloth triangles (cloth)
 
   std::vector<DistanceConstraint> distance;
@@ -43,6 +44,11 @@ struct BodyModel {
   std::vector<StrainConstraint> strain;
   std::vector<BendConstraint> bend;
   std::optional<ShapeMatchModel> shapeMatching;
+
+  /// The first batched* constraints of each array come in groups of kLanes that share no particle
+  /// (lane_batches.h); the solver projects each group at once. Builders order constraints so;
+  /// hand-built models may leave these 0.
+  std::size_t batchedDistance = 0, batchedVolume = 0, batchedStrain = 0;
 
   ConstraintDamping damping;
   float particleRadius = 0.0f;  ///< contact offset against colliders (m)

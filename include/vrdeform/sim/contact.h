@@ -78,8 +78,8 @@ SphereContactEval<S> evalSphereContact(const Vec3T<S>& p, const Vec3T<S>& center
 }
 
 /// Eqs. 38-39 with the inequality clamp: returns dLambda (>= -lambda); the particle moves by w n dLambda.
-inline Correction<1> solveFingertipContact(const Point& p, const Vec3& center, float radius, float lambda,
-                                           const XpbdCoefficients& k) {
+inline Correction<Vec3, 1> solveFingertipContact(const Point& p, const Vec3& center, float radius, float lambda,
+                                                 const XpbdCoefficients& k) {
   const SphereContactEval<float> e = evalSphereContact(p.pos, center, radius);
   if (e.n.isZero() || (e.C >= 0.0f && lambda <= 0.0f)) return {0.0f, {Vec3::Zero()}};
   const float newLambda = std::max(lambda + deltaLambda(e.C, lambda, p.w, k), 0.0f);

@@ -11,27 +11,30 @@ struct DistanceConstraint {
   float compliance;  ///< alpha (m/N)
 };
 
-template <typename S>
+template <typename V>
 struct DistanceEval {
-  S C;         ///< eq. 7: |p1 - p2| - l0
-  Vec3T<S> n;  ///< eq. 8: grad_p1 C = (p1 - p2)/|p1 - p2|; eq. 9: grad_p2 C = -n. Zero when p1 = p2.
+  typename V::Scalar C;  ///< eq. 7: |p1 - p2| - l0; 0 when p1 = p2 (no direction to push along)
+  V n;                   ///< eq. 8: grad_p1 C = (p1 - p2)/|p1 - p2|; eq. 9: grad_p2 C = -n. Zero when p1 = p2.
 };
 
-template <typename S>
-DistanceEval<S> evalDistance(const Vec3T<S>& p1, const Vec3T<S>& p2, S restLength) {
-  const Vec3T<S> d = p1 - p2;
-  const S length = d.norm();
-  if (!(length > S(0))) return {-restLength, Vec3T<S>::Zero()};
-  return {length - restLength, d / length};
+template <typename V>
+DistanceEval<V> evalDistance(const V& p1, const V& p2, typename V::Scalar restLength) {
+  using T = typename V::Scalar;
+  const V d = p1 - p2;
+  const T length = sqrt(d.squaredNorm());
+  const auto apart = length > splat<T>(0.0);
+  const T inverse = select(apart, splat<T>(1.0) / length, splat<T>(0.0));
+  return {select(apart, length - restLength, splat<T>(0.0)), d * inverse};
 }
 
 /// Eqs. 10-15 with damping. (Eqs. 11-12 as printed flip the sign of dp1; eq. 3 is the rule.)
-/// Coincident particles give no correction: the direction is undefined.
-inline Correction<2> solveDistance(const Point (&p)[2], float restLength, float lambda, const XpbdCoefficients& k,
-                                   const Vec3* disp = nullptr) {
-  const DistanceEval<float> e = evalDistance(p[0].pos, p[1].pos, restLength);
-  const Vec3 grad[2] = {e.n, -e.n};
-  return projectScalar(p, e.n.isZero() ? 0.0f : e.C, grad, lambda, k, disp);
+template <typename V>
+Correction<V, 2> solveDistance(const V (&x)[2], const typename V::Scalar (&w)[2], typename V::Scalar restLength,
+                               typename V::Scalar lambda, const XpbdCoefficientsT<typename V::Scalar>& k,
+                               const V* disp = nullptr) {
+  const DistanceEval<V> e = evalDistance(x[0], x[1], restLength);
+  const V grad[2] = {e.n, -e.n};
+  return projectScalar(w, e.C, grad, lambda, k, disp);
 }
 
 }  // namespace vrd

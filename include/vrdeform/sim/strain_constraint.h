@@ -6,8 +6,8 @@
 // its own multiplier, solved one after another inside the tet (local Gauss-Seidel).
 
 #include <array>
+#include <utility>
 
-#include "vrdeform/sim/particles.h"
 #include "vrdeform/sim/xpbd.h"
 
 namespace vrd {
@@ -25,7 +25,8 @@ inline constexpr int kStrainAxes[kStrainComponents][2] = {{0, 0}, {1, 1}, {2, 2}
 inline bool isStretchComponent(int c) { return c < 3; }
 
 /// The six multipliers of a tet's strain constraints, in component order.
-using StrainLambda = std::array<float, kStrainComponents>;
+template <typename T> using StrainLambdaT = std::array<T, kStrainComponents>;
+using StrainLambda = StrainLambdaT<float>;
 
 /// Per-particle weights a_k with F = sum_k p_k a_k^T: a_k is row k-1 of D_rest^-1 and
 /// a_0 = -(a_1 + a_2 + a_3). So grad_{p_k} S_ij = a_k[i] f_j + a_k[j] f_i for the columns f of F.
@@ -65,90 +66,96 @@ StrainComponentEval<S> evalStrainComponent(const Vec3T<S>& p1, const Vec3T<S>& p
   return e;
 }
 
+template <typename V>
 struct StrainCorrection {
-  StrainLambda dLambda;
-  Vec3 dp[4];
+  StrainLambdaT<typename V::Scalar> dLambda;
+  V dp[4];
 };
 
-/// One local Gauss-Seidel sweep over the six strain constraints of a tet.
+/// One local Gauss-Seidel sweep over the six strain constraints of a tet, for particles x with
+/// inverse masses w and strain weights a (see strainWeights).
 ///
 /// Equal, up to rounding, to projecting the components one after another and re-evaluating F from
 /// the moved particles each time (solveStrainReference), but in closed form: with
 /// B = sum_k w_k a_k a_k^T, the correction of component (i, j) changes F by a rank-1 term and the
 /// denominator of eq. 1 is sum_k w_k |grad_k S_ij|^2 = B_ii |f_j|^2 + B_jj |f_i|^2 + 2 B_ij S_ij.
 /// The particles' corrections are gathered in U and applied once: dp_k = w_k U a_k.
-/// (Columns are kept as separate 3-vectors: Eigen's partly vectorised 3x3 ops stall on
-/// store-to-load forwarding here.)
-inline StrainCorrection solveStrain(const Point (&p)[4], const Mat3& invRestShape, const StrainLambda& lambda,
-                                    const XpbdCoefficients& stretch, const XpbdCoefficients& shear,
-                                    const Vec3* disp = nullptr) {
-  const auto a = strainWeights(invRestShape);
-  Vec3 f[3], D[3], U[3];  // columns of F, of the displacement gradient (damping) and of U
-  float B[3][3];
+template <typename V>
+StrainCorrection<V> solveStrain(const V (&x)[4], const typename V::Scalar (&w)[4], const V (&a)[4],
+                                const StrainLambdaT<typename V::Scalar>& lambda,
+                                const XpbdCoefficientsT<typename V::Scalar>& stretch,
+                                const XpbdCoefficientsT<typename V::Scalar>& shear, const V* disp = nullptr) {
+  using T = typename V::Scalar;
+  V f[3], D[3], U[3];  // columns of F, of the displacement gradient (damping) and of U
+  T B[3][3];
   for (int i = 0; i < 3; ++i) {
-    f[i] = a[0][i] * p[0].pos + a[1][i] * p[1].pos + a[2][i] * p[2].pos + a[3][i] * p[3].pos;
-    D[i] = disp ? Vec3(a[0][i] * disp[0] + a[1][i] * disp[1] + a[2][i] * disp[2] + a[3][i] * disp[3]) : Vec3::Zero();
-    U[i].setZero();
+    f[i] = a[0][i] * x[0] + a[1][i] * x[1] + a[2][i] * x[2] + a[3][i] * x[3];
+    D[i] = disp ? V(a[0][i] * disp[0] + a[1][i] * disp[1] + a[2][i] * disp[2] + a[3][i] * disp[3]) : V(V::Zero());
+    U[i] = V::Zero();
     for (int j = i; j < 3; ++j)
-      B[i][j] = B[j][i] = p[0].w * a[0][i] * a[0][j] + p[1].w * a[1][i] * a[1][j] + p[2].w * a[2][i] * a[2][j] +
-                          p[3].w * a[3][i] * a[3][j];
+      B[i][j] = B[j][i] = w[0] * a[0][i] * a[0][j] + w[1] * a[1][i] * a[1][j] + w[2] * a[2][i] * a[2][j] +
+                          w[3] * a[3][i] * a[3][j];
   }
 
-  StrainCorrection out;
-  for (int c = 0; c < kStrainComponents; ++c) {
-    const int i = kStrainAxes[c][0], j = kStrainAxes[c][1];
-    const float Sij = f[i].dot(f[j]);
-    Vec3 gi, gj;  // changes of U's columns i and j
-    if (i == j) {
-      out.dLambda[c] = deltaLambda(Sij - 1.0f, lambda[c], 4.0f * B[i][i] * Sij, stretch, 2.0f * f[i].dot(D[i]));
-      gi = 2.0f * out.dLambda[c] * f[i];
-      gj.setZero();
+  StrainCorrection<V> out;
+  // One component; c is a template argument so that i and j are constants and f, B and U stay in
+  // registers (a runtime loop over kStrainAxes keeps them in memory).
+  auto project = [&]<int c>() {
+    constexpr int i = kStrainAxes[c][0], j = kStrainAxes[c][1];
+    const T Sij = f[i].dot(f[j]);
+    V gi, gj;  // changes of U's columns i and j
+    if constexpr (i == j) {
+      out.dLambda[c] = deltaLambda(T(Sij - 1.0f), lambda[c], T(4.0f * B[i][i] * Sij), stretch, T(2.0f * f[i].dot(D[i])));
+      gi = (2.0f * out.dLambda[c]) * f[i];
+      U[i] += gi;
+      for (int m = 0; m < 3; ++m) {  // F += gi B_i. (the rank-1 change of F)
+        const V dF = B[i][m] * gi;
+        f[m] += dF;
+        if (disp) D[m] += dF;
+      }
     } else {
-      const float gradMinvGrad = B[i][i] * f[j].squaredNorm() + B[j][j] * f[i].squaredNorm() + 2.0f * B[i][j] * Sij;
-      out.dLambda[c] = deltaLambda(Sij, lambda[c], gradMinvGrad, shear, f[j].dot(D[i]) + f[i].dot(D[j]));
+      const T gradMinvGrad = B[i][i] * f[j].squaredNorm() + B[j][j] * f[i].squaredNorm() + 2.0f * B[i][j] * Sij;
+      out.dLambda[c] = deltaLambda(Sij, lambda[c], gradMinvGrad, shear, T(f[j].dot(D[i]) + f[i].dot(D[j])));
       gi = out.dLambda[c] * f[j];
       gj = out.dLambda[c] * f[i];
+      U[i] += gi;
+      U[j] += gj;
+      for (int m = 0; m < 3; ++m) {  // F += gi B_i. + gj B_j.
+        const V dF = B[i][m] * gi + B[j][m] * gj;
+        f[m] += dF;
+        if (disp) D[m] += dF;
+      }
     }
-    U[i] += gi;
-    U[j] += gj;
-    for (int m = 0; m < 3; ++m) {  // F += gi B_i. + gj B_j. (the rank-1 change of F)
-      const Vec3 dF = B[i][m] * gi + B[j][m] * gj;
-      f[m] += dF;
-      if (disp) D[m] += dF;
-    }
-  }
-  for (int k = 0; k < 4; ++k) out.dp[k] = p[k].w * (a[k][0] * U[0] + a[k][1] * U[1] + a[k][2] * U[2]);
+  };
+  [&]<int... c>(std::integer_sequence<int, c...>) { (project.template operator()<c>(), ...); }
+  (std::make_integer_sequence<int, kStrainComponents>{});
+  for (int k = 0; k < 4; ++k) out.dp[k] = w[k] * V(a[k][0] * U[0] + a[k][1] * U[1] + a[k][2] * U[2]);
   return out;
 }
 
 /// The straightforward form of solveStrain: project each component with eq. 1 and eq. 3,
 /// re-evaluating F from the moved particles every time. The reference for tests and the baseline
 /// in benchmarks.
-inline StrainCorrection solveStrainReference(const Point (&p)[4], const Mat3& invRestShape,
-                                             const StrainLambda& lambda,
-                                             const XpbdCoefficients& stretch, const XpbdCoefficients& shear,
-                                             const Vec3* disp = nullptr) {
+inline StrainCorrection<Vec3> solveStrainReference(const Vec3 (&x0)[4], const float (&w)[4], const Mat3& invRestShape,
+                                                   const StrainLambda& lambda, const XpbdCoefficients& stretch,
+                                                   const XpbdCoefficients& shear, const Vec3* disp = nullptr) {
   Vec3 x[4], d[4];
   for (int k = 0; k < 4; ++k) {
-    x[k] = p[k].pos;
+    x[k] = x0[k];
     d[k] = disp ? disp[k] : Vec3::Zero();
   }
-  StrainCorrection out;
+  StrainCorrection<Vec3> out;
   for (int c = 0; c < kStrainComponents; ++c) {
     const StrainComponentEval<float> e = evalStrainComponent(x[0], x[1], x[2], x[3], invRestShape, c);
-    float gradMinvGrad = 0.0f, gradDotDisp = 0.0f;
+    const Correction<Vec3, 4> r =
+        projectScalar(w, e.C, e.grad, lambda[c], isStretchComponent(c) ? stretch : shear, disp ? d : nullptr);
+    out.dLambda[c] = r.dLambda;
     for (int k = 0; k < 4; ++k) {
-      gradMinvGrad += p[k].w * e.grad[k].squaredNorm();
-      if (disp) gradDotDisp += e.grad[k].dot(d[k]);
-    }
-    out.dLambda[c] = deltaLambda(e.C, lambda[c], gradMinvGrad, isStretchComponent(c) ? stretch : shear, gradDotDisp);
-    for (int k = 0; k < 4; ++k) {
-      const Vec3 step = p[k].w * out.dLambda[c] * e.grad[k];
-      x[k] += step;
-      d[k] += step;
+      x[k] += r.dp[k];
+      d[k] += r.dp[k];
     }
   }
-  for (int k = 0; k < 4; ++k) out.dp[k] = x[k] - p[k].pos;
+  for (int k = 0; k < 4; ++k) out.dp[k] = x[k] - x0[k];
   return out;
 }
 

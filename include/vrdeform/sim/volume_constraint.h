@@ -15,30 +15,31 @@ struct VolumeConstraint {
   float compliance;  ///< alpha (m^3/N)
 };
 
-template <typename S>
+template <typename V>
 struct VolumeEval {
-  S C;               ///< eq. 17: V - V0
-  Vec3T<S> grad[4];  ///< eqs. 18-21: one sixth of each opposite face's area vector, pointing outward
+  typename V::Scalar C;  ///< eq. 17: V - V0
+  V grad[4];             ///< eqs. 18-21: one sixth of each opposite face's area vector, pointing outward
 };
 
-template <typename S>
-VolumeEval<S> evalVolume(const Vec3T<S>& p1, const Vec3T<S>& p2, const Vec3T<S>& p3, const Vec3T<S>& p4,
-                         S restVolume) {
-  constexpr S sixth = S(1) / S(6);
-  VolumeEval<S> e;
-  e.C = signedTetVolume(p1, p2, p3, p4) - restVolume;
-  e.grad[0] = sixth * (p2 - p3).cross(p4 - p3);
-  e.grad[1] = sixth * (p3 - p1).cross(p4 - p1);
-  e.grad[2] = sixth * (p1 - p2).cross(p4 - p2);
-  e.grad[3] = sixth * (p2 - p1).cross(p3 - p1);
+template <typename V>
+VolumeEval<V> evalVolume(const V& p1, const V& p2, const V& p3, const V& p4, typename V::Scalar restVolume) {
+  const auto sixth = splat<typename V::Scalar>(1.0 / 6.0);
+  VolumeEval<V> e;
+  e.grad[3] = sixth * V((p2 - p1).cross(p3 - p1));
+  e.C = e.grad[3].dot(p4 - p1) - restVolume;  // eq. 16: V = (p2-p1)x(p3-p1).(p4-p1)/6
+  e.grad[0] = sixth * V((p2 - p3).cross(p4 - p3));
+  e.grad[1] = sixth * V((p3 - p1).cross(p4 - p1));
+  e.grad[2] = sixth * V((p1 - p2).cross(p4 - p2));
   return e;
 }
 
 /// Eqs. 22-23 with damping: one XPBD projection of the volume constraint.
-inline Correction<4> solveVolume(const Point (&p)[4], float restVolume, float lambda, const XpbdCoefficients& k,
-                                 const Vec3* disp = nullptr) {
-  const VolumeEval<float> e = evalVolume(p[0].pos, p[1].pos, p[2].pos, p[3].pos, restVolume);
-  return projectScalar(p, e.C, e.grad, lambda, k, disp);
+template <typename V>
+Correction<V, 4> solveVolume(const V (&x)[4], const typename V::Scalar (&w)[4], typename V::Scalar restVolume,
+                             typename V::Scalar lambda, const XpbdCoefficientsT<typename V::Scalar>& k,
+                             const V* disp = nullptr) {
+  const VolumeEval<V> e = evalVolume(x[0], x[1], x[2], x[3], restVolume);
+  return projectScalar(w, e.C, e.grad, lambda, k, disp);
 }
 
 }  // namespace vrd

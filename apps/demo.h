@@ -1,0 +1,19 @@
+#pragma once
+// The headless demo behind `vrdeform run` (until scene files arrive): a jelly cube dropped on
+// the ground, poked by a fingertip, released; prints what happened and where the time went.
+
+namespace vrd {
+
+struct DemoOptions {
+  float seconds = 4.0f;
+  int substeps = 1;
+  int iterations = 5;
+  int tets = 1000;         ///< approximate tet count of the cube
+  bool paperMaterial = false;  ///< the paper's compliance 0.3 / damping 0.03 instead of E, nu, rho
+  float reportEvery = 0.25f;   ///< seconds between timeline rows
+};
+
+/// Runs the demo, printing to stdout; returns the process exit code.
+int runDemo(const DemoOptions& options);
+
+}  // namespace vrd

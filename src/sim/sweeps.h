@@ -1,0 +1,185 @@
+#pragma once
+// One Gauss-Seidel sweep per constraint type over a body, written once for lane width 1 (float,
+// Eigen vectors) and 4 (Lane4, V3<Lane4>). A sweep over [begin, end) with T = Lane4 takes four
+// consecutive, independent constraints at a time (lane_batches.h), which is the same sweep as
+// taking them one by one.
+
+#include <cstring>
+#include <type_traits>
+
+#include "vrdeform/sim/body.h"
+#include "vrdeform/sim/lane_batches.h"
+
+namespace vrd::sweeps {
+
+template <typename T> inline constexpr std::size_t kWidth = std::is_same_v<T, Lane4> ? kLanes : 1;
+template <typename T> using VecOf = std::conditional_t<std::is_same_v<T, Lane4>, V3<Lane4>, Vec3>;
+
+/// The N particles of one constraint (T = float) or of kLanes constraints (T = Lane4), with their
+/// inverse masses and, when damped, their motion since the start of the substep.
+template <typename T, std::size_t N, bool Damped>
+struct Gathered {
+  using V = VecOf<T>;
+  V x[N], disp[N];
+  T w[N];
+  Index idx[N][kWidth<T>];
+
+  template <typename C>
+  Gathered(const C* c, const Point* pred, const Point* start) {
+    for (std::size_t a = 0; a < N; ++a) {
+      for (std::size_t l = 0; l < kWidth<T>; ++l) idx[a][l] = c[l].i[a];
+      load(pred, idx[a], x[a], w[a]);
+      if constexpr (Damped) {
+        V xs;
+        T ws;
+        load(start, idx[a], xs, ws);
+        disp[a] = x[a] - xs;
+      }
+    }
+  }
+  const V* displacement() const { return Damped ? disp : nullptr; }
+
+  void scatter(const V (&dp)[N], Point* pred) const {
+    for (std::size_t a = 0; a < N; ++a) add(pred, idx[a], dp[a]);
+  }
+
+private:
+  static void load(const Point* pts, const Index (&i)[1], Vec3& x, float& w) {
+    x = pts[i[0]].pos;
+    w = pts[i[0]].w;
+  }
+  static void add(Point* pts, const Index (&i)[1], const Vec3& d) { pts[i[0]].pos += d; }
+
+  // A Point is 16 aligned bytes (x, y, z, w): four loads and a transpose give the lanes.
+  static void load(const Point* pts, const Index (&i)[kLanes], V3<Lane4>& x, Lane4& w) {
+    __m128 r0 = _mm_load_ps(pts[i[0]].pos.data()), r1 = _mm_load_ps(pts[i[1]].pos.data());
+    __m128 r2 = _mm_load_ps(pts[i[2]].pos.data()), r3 = _mm_load_ps(pts[i[3]].pos.data());
+    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+    x = {r0, r1, r2};
+    w = r3;
+  }
+  static void add(Point* pts, const Index (&i)[kLanes], const V3<Lane4>& d) {
+    __m128 r0 = d.x, r1 = d.y, r2 = d.z, r3 = _mm_setzero_ps();  // w += 0
+    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+    const __m128 rows[kLanes] = {r0, r1, r2, r3};
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      float* p = pts[i[l]].pos.data();
+      _mm_store_ps(p, _mm_add_ps(_mm_load_ps(p), rows[l]));
+    }
+  }
+};
+
+/// A per-constraint float field as a scalar or as lanes.
+template <typename T, typename C>
+T fieldOf(const C* c, float C::*field) {
+  if constexpr (std::is_same_v<T, Lane4>)
+    return Lane4{c[0].*field, c[1].*field, c[2].*field, c[3].*field};
+  else
+    return c[0].*field;
+}
+
+template <typename T>
+T loadLambda(const float* lambda) {
+  T v;
+  std::memcpy(&v, lambda, sizeof(T));
+  return v;
+}
+template <typename T>
+void addLambda(float* lambda, T delta) {
+  const T v = loadLambda<T>(lambda) + delta;
+  std::memcpy(lambda, &v, sizeof(T));
+}
+
+// Everything a sweep needs about the body it runs over.
+struct Range {
+  Point* pred;         // the body's predicted positions
+  const Point* start;  // and its positions at the start of the substep
+  float invH;          // 1/h
+};
+
+template <typename T, bool Damped>
+void distance(const DistanceConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau,
+              const Range& r) {
+  for (std::size_t i = begin; i < end; i += kWidth<T>) {
+    const Gathered<T, 2, Damped> g(c + i, r.pred, r.start);
+    const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &DistanceConstraint::compliance), splat<T>(tau), r.invH);
+    const auto out = solveDistance(g.x, g.w, fieldOf<T>(c + i, &DistanceConstraint::restLength),
+                                   loadLambda<T>(lambda + i), k, g.displacement());
+    addLambda(lambda + i, out.dLambda);
+    g.scatter(out.dp, r.pred);
+  }
+}
+
+template <typename T, bool Damped>
+void volume(const VolumeConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau, const Range& r) {
+  for (std::size_t i = begin; i < end; i += kWidth<T>) {
+    const Gathered<T, 4, Damped> g(c + i, r.pred, r.start);
+    const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &VolumeConstraint::compliance), splat<T>(tau), r.invH);
+    const auto out = solveVolume(g.x, g.w, fieldOf<T>(c + i, &VolumeConstraint::restVolume),
+                                 loadLambda<T>(lambda + i), k, g.displacement());
+    addLambda(lambda + i, out.dLambda);
+    g.scatter(out.dp, r.pred);
+  }
+}
+
+// Strain weights a_k (strainWeights) of one tet or of kLanes tets.
+template <typename T>
+void strainWeightsOf(const StrainConstraint* c, VecOf<T> (&a)[4]) {
+  if constexpr (std::is_same_v<T, Lane4>) {
+    for (int k = 0; k < 3; ++k) {
+      auto lane = [&](int col) {
+        return Lane4{c[0].invRestShape(k, col), c[1].invRestShape(k, col), c[2].invRestShape(k, col),
+                     c[3].invRestShape(k, col)};
+      };
+      a[k + 1] = {lane(0), lane(1), lane(2)};
+    }
+    a[0] = -(a[1] + a[2] + a[3]);
+  } else {
+    const auto w = strainWeights(c[0].invRestShape);
+    for (int k = 0; k < 4; ++k) a[k] = w[k];
+  }
+}
+
+template <typename T, bool Damped>
+void strain(const StrainConstraint* c, std::size_t begin, std::size_t end, StrainLambda* lambda,
+            const ConstraintDamping& damping, const Range& r) {
+  for (std::size_t i = begin; i < end; i += kWidth<T>) {
+    const Gathered<T, 4, Damped> g(c + i, r.pred, r.start);
+    VecOf<T> a[4];
+    strainWeightsOf<T>(c + i, a);
+    const auto stretch = XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &StrainConstraint::stretchCompliance),
+                                                    splat<T>(damping.strainStretch), r.invH);
+    const auto shear = XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &StrainConstraint::shearCompliance),
+                                                  splat<T>(damping.strainShear), r.invH);
+    StrainLambdaT<T> l;  // lambda[i + lane][component] -> l[component][lane]
+    for (int comp = 0; comp < kStrainComponents; ++comp)
+      if constexpr (std::is_same_v<T, Lane4>)
+        l[comp] = Lane4{lambda[i][comp], lambda[i + 1][comp], lambda[i + 2][comp], lambda[i + 3][comp]};
+      else
+        l[comp] = lambda[i][comp];
+    const auto out = solveStrain(g.x, g.w, a, l, stretch, shear, g.displacement());
+    for (std::size_t lane = 0; lane < kWidth<T>; ++lane)
+      for (int comp = 0; comp < kStrainComponents; ++comp)
+        if constexpr (std::is_same_v<T, Lane4>)
+          lambda[i + lane][comp] += out.dLambda[comp][lane];
+        else
+          lambda[i][comp] += out.dLambda[comp];
+    g.scatter(out.dp, r.pred);
+  }
+}
+
+/// Runs Sweep over [0, count): four at a time over the batched prefix when simd is on, then one
+/// at a time; with the damped or undamped kernel.
+template <typename Run>
+void widths(bool simd, std::size_t batched, std::size_t count, bool damped, Run run) {
+  const std::size_t split = simd ? batched : 0;
+  if (damped) {
+    run(std::integral_constant<bool, true>{}, Lane4{}, 0, split);
+    run(std::integral_constant<bool, true>{}, 0.0f, split, count);
+  } else {
+    run(std::integral_constant<bool, false>{}, Lane4{}, 0, split);
+    run(std::integral_constant<bool, false>{}, 0.0f, split, count);
+  }
+}
+
+}  // namespace vrd::sweeps
