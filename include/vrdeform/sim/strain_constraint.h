@@ -86,11 +86,13 @@ StrainCorrection<V> solveStrain(const V (&x)[4], const typename V::Scalar (&w)[4
                                 const XpbdCoefficientsT<typename V::Scalar>& stretch,
                                 const XpbdCoefficientsT<typename V::Scalar>& shear, const V* disp = nullptr) {
   using T = typename V::Scalar;
-  V f[3], D[3], U[3];  // columns of F, of the displacement gradient (damping) and of U
+  V f[3], fStart[3], U[3];  // columns of F, of F at the start of the substep (damping) and of U
   T B[3][3];
   for (int i = 0; i < 3; ++i) {
     f[i] = a[0][i] * x[0] + a[1][i] * x[1] + a[2][i] * x[2] + a[3][i] * x[3];
-    D[i] = disp ? V(a[0][i] * disp[0] + a[1][i] * disp[1] + a[2][i] * disp[2] + a[3][i] * disp[3]) : V(V::Zero());
+    // grad C . disp = f_j.D_i + f_i.D_j with the displacement gradient D = F - F(start).
+    fStart[i] = disp ? V(f[i] - (a[0][i] * disp[0] + a[1][i] * disp[1] + a[2][i] * disp[2] + a[3][i] * disp[3]))
+                     : V(V::Zero());
     U[i] = V::Zero();
     for (int j = i; j < 3; ++j)
       B[i][j] = B[j][i] = w[0] * a[0][i] * a[0][j] + w[1] * a[1][i] * a[1][j] + w[2] * a[2][i] * a[2][j] +
@@ -105,26 +107,20 @@ StrainCorrection<V> solveStrain(const V (&x)[4], const typename V::Scalar (&w)[4
     const T Sij = f[i].dot(f[j]);
     V gi, gj;  // changes of U's columns i and j
     if constexpr (i == j) {
-      out.dLambda[c] = deltaLambda(T(Sij - 1.0f), lambda[c], T(4.0f * B[i][i] * Sij), stretch, T(2.0f * f[i].dot(D[i])));
+      const T gradDotDisp = disp ? T(2.0f * f[i].dot(f[i] - fStart[i])) : splat<T>(0.0);
+      out.dLambda[c] = deltaLambda(T(Sij - 1.0f), lambda[c], T(4.0f * B[i][i] * Sij), stretch, gradDotDisp);
       gi = (2.0f * out.dLambda[c]) * f[i];
       U[i] += gi;
-      for (int m = 0; m < 3; ++m) {  // F += gi B_i. (the rank-1 change of F)
-        const V dF = B[i][m] * gi;
-        f[m] += dF;
-        if (disp) D[m] += dF;
-      }
+      for (int m = 0; m < 3; ++m) f[m] += B[i][m] * gi;  // F += gi B_i. (the rank-1 change of F)
     } else {
       const T gradMinvGrad = B[i][i] * f[j].squaredNorm() + B[j][j] * f[i].squaredNorm() + 2.0f * B[i][j] * Sij;
-      out.dLambda[c] = deltaLambda(Sij, lambda[c], gradMinvGrad, shear, T(f[j].dot(D[i]) + f[i].dot(D[j])));
+      const T gradDotDisp = disp ? T(f[j].dot(f[i] - fStart[i]) + f[i].dot(f[j] - fStart[j])) : splat<T>(0.0);
+      out.dLambda[c] = deltaLambda(Sij, lambda[c], gradMinvGrad, shear, gradDotDisp);
       gi = out.dLambda[c] * f[j];
       gj = out.dLambda[c] * f[i];
       U[i] += gi;
       U[j] += gj;
-      for (int m = 0; m < 3; ++m) {  // F += gi B_i. + gj B_j.
-        const V dF = B[i][m] * gi + B[j][m] * gj;
-        f[m] += dF;
-        if (disp) D[m] += dF;
-      }
+      for (int m = 0; m < 3; ++m) f[m] += B[i][m] * gi + B[j][m] * gj;  // F += gi B_i. + gj B_j.
     }
   };
   [&]<int... c>(std::integer_sequence<int, c...>) { (project.template operator()<c>(), ...); }
