@@ -11,11 +11,11 @@
 namespace vrd {
 namespace {
 
-constexpr float kSize = 0.1f;         // a 10 cm cube
-constexpr float kDrop = 0.05f;        // dropped from 5 cm
-constexpr float kFingerRadius = 0.01f;
+constexpr float kSize = 0.1f;   // a 10 cm cube
+constexpr float kDrop = 0.05f;  // dropped from 5 cm
+constexpr float kFingerRadius = 0.02f;  // a fingertip pad: it spans several surface particles
 constexpr float kPokeStart = 1.5f, kPokeDown = 1.0f, kPokeHold = 0.5f;  // s
-constexpr float kPokeDepth = 0.03f;   // 3 cm into the top face
+constexpr float kPokeDepth = 0.03f;                                     // 3 cm into the top face
 
 Material demoMaterial(bool paper) {
   Material m;  // the paper's compliance 0.3 / damping 0.03 by default
@@ -47,15 +47,17 @@ int runDemo(const DemoOptions& o) {
 
   double mass = 0.0;
   for (float w : model->invMass) mass += 1.0 / w;
-  fmt::print("vrdeform demo: a {:.0f} cm jelly cube ({} particles, {} tets, {:.2f} kg) dropped {:.0f} cm onto the ground,\n"
-             "poked {:.0f} cm deep by a {:.0f} mm fingertip at t = {:.1f} s and released.\n",
-             kSize * 100, model->particleCount(), model->tets.size(), mass, kDrop * 100, kPokeDepth * 100,
-             kFingerRadius * 1000, kPokeStart);
-  fmt::print("Material: {}. Solver: dt = 1/{:.0f} s, {} substep(s) x {} iteration(s); constraints: {} volume, "
-             "{} strain (x6), shape matching.\n\n",
-             o.paperMaterial ? "paper compliance 0.3, damping 0.03, 1 kg per particle"
-                             : "E = 5 kPa, nu = 0.45, rho = 1000 kg/m^3",
-             1.0f / settings.timeStep, o.substeps, o.iterations, model->volume.size(), model->strain.size());
+  fmt::print(
+      "vrdeform demo: a {:.0f} cm jelly cube ({} particles, {} tets, {:.2f} kg) dropped {:.0f} cm onto the ground,\n"
+      "poked {:.0f} cm deep by a {:.0f} mm fingertip at t = {:.1f} s and released.\n",
+      kSize * 100, model->particleCount(), model->tets.size(), mass, kDrop * 100, kPokeDepth * 100,
+      kFingerRadius * 1000, kPokeStart);
+  fmt::print(
+      "Material: {}. Solver: dt = 1/{:.0f} s, {} substep(s) x {} iteration(s); constraints: {} volume, "
+      "{} strain (x6), shape matching.\n\n",
+      o.paperMaterial ? "paper compliance 0.3, damping 0.03, 1 kg per particle"
+                      : "E = 5 kPa, nu = 0.45, rho = 1000 kg/m^3",
+      1.0f / settings.timeStep, o.substeps, o.iterations, model->volume.size(), model->strain.size());
   fmt::print("{:>6} {:>9} {:>9} {:>9} {:>10} {:>9} {:>10}\n", "t (s)", "top (cm)", "base (cm)", "vol. loss",
              "finger (N)", "contacts", "ground (N)");
 
@@ -92,8 +94,8 @@ int runDemo(const DemoOptions& o) {
     if (sum.ms[k] > 0.0) fmt::print("  {:<15} {:8.4f}\n", stageName(Stage(k)), sum.ms[k] / steps);
   fmt::print("  {:<15} {:8.4f}   (the paper's Table 3: 9.27 ms for its XPBD step, Unity/C#, i7-13700K)\n", "total",
              sum.totalMs() / steps);
-  fmt::print("\nPeak fingertip force {:.3f} N, peak volume loss {:.2f}%, weight {:.3f} N.\n", peakForce,
-             100 * peakLoss, mass * 9.81);
+  fmt::print("\nPeak fingertip force {:.3f} N, peak volume loss {:.2f}%, weight {:.3f} N.\n", peakForce, 100 * peakLoss,
+             mass * 9.81);
   return 0;
 }
 

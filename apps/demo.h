@@ -6,9 +6,9 @@ namespace vrd {
 
 struct DemoOptions {
   float seconds = 4.0f;
-  int substeps = 1;
+  int substeps = 4;
   int iterations = 5;
-  int tets = 1000;         ///< approximate tet count of the cube
+  int tets = 1000;             ///< approximate tet count of the cube
   bool paperMaterial = false;  ///< the paper's compliance 0.3 / damping 0.03 instead of E, nu, rho
   float reportEvery = 0.25f;   ///< seconds between timeline rows
 };

@@ -1,6 +1,6 @@
 // vrdeform: the command-line program.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "demo.h"
 #include "vrdeform/error.h"
@@ -13,11 +13,15 @@ int main(int argc, char** argv) {
   vrd::DemoOptions demo;
   CLI::App* run = app.add_subcommand("run", "Simulate the built-in demo headless and print what happened");
   run->add_option("--seconds", demo.seconds, "Simulated time")->check(CLI::Range(0.0f, 3600.0f))->capture_default_str();
-  run->add_option("--substeps", demo.substeps, "Substeps per 1/60 s step")->check(CLI::Range(1, 1000))->capture_default_str();
+  run->add_option("--substeps", demo.substeps, "Substeps per 1/60 s step")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
   run->add_option("--iterations", demo.iterations, "Gauss-Seidel iterations per substep")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
-  run->add_option("--tets", demo.tets, "Approximate number of tetrahedra")->check(CLI::Range(6, 2000000))->capture_default_str();
+  run->add_option("--tets", demo.tets, "Approximate number of tetrahedra")
+      ->check(CLI::Range(6, 2000000))
+      ->capture_default_str();
   run->add_flag("--paper-material", demo.paperMaterial, "Use the paper's compliance/damping instead of E, nu, rho");
   run->add_option("--report-every", demo.reportEvery, "Seconds between timeline rows")
       ->check(CLI::Range(0.001f, 3600.0f))

@@ -98,7 +98,8 @@ struct BlockOnGround {
   BlockOnGround() : world(settings()) {
     Material m;
     m.elastic = ElasticModuli{2e4f, 0.3f, 1000.0f};
-    const TetMesh mesh = makeBoxTets(Vec3(-0.05f, 0.0f, -0.05f), Vec3(0.1f, 0.1f, 0.1f), 4, 4, 4);  // a vertex at the top centre
+    const TetMesh mesh =
+        makeBoxTets(Vec3(-0.05f, 0.0f, -0.05f), Vec3(0.1f, 0.1f, 0.1f), 4, 4, 4);  // a vertex at the top centre
     body = world.addBody(makeSoftBody(mesh, m, {false, true, true, false}));
     world.addCollider(Collider::plane(Vec3::UnitY()));
     weight = 1000.0f * 1e-3f * kG;  // rho V g
@@ -136,7 +137,7 @@ TEST(Contact, FingertipPushBalancesGroundReaction) {
   // fingertip force equals the ground reaction minus the weight, to 1e-3.
   BlockOnGround block;
   const FingertipId tip = block.world.addFingertip(Vec3(0.0f, 0.2f, 0.0f), 0.03f);
-  for (int step = 0; step < 60; ++step) block.world.step();  // settle first
+  for (int step = 0; step < 60; ++step) block.world.step();                // settle first
   block.world.moveFingertip(tip, Vec3(0.0f, 0.1f + 0.03f - 0.01f, 0.0f));  // 1 cm into the top face
   for (int step = 0; step < 300; ++step) block.world.step();
   const Vec3 push = block.world.fingertipForce(tip);

@@ -148,7 +148,8 @@ TEST(Gradients, BendRandom) {
 
 TEST(Gradients, BendNearFlatAndNearFolded) {
   std::mt19937 rng(5);
-  for (double theta : {0.0, 1e-6, -1e-6, 1e-3, -1e-3}) checkBend(hinge(theta, rng, 0.0), "flat " + std::to_string(theta));
+  for (double theta : {0.0, 1e-6, -1e-6, 1e-3, -1e-3})
+    checkBend(hinge(theta, rng, 0.0), "flat " + std::to_string(theta));
   for (double theta : {3.1, -3.1, 3.14, -3.14}) checkBend(hinge(theta, rng, 0.0), "folded " + std::to_string(theta));
   for (int trial = 0; trial < 50; ++trial) checkBend(hinge(1e-4 * (trial - 25), rng), "jittered near flat");
 }
@@ -175,7 +176,9 @@ TEST(Gradients, FingertipContact) {
   for (int trial = 0; trial < 100; ++trial) {
     std::array<V, 2> p{randomPoint(rng), randomPoint(rng)};  // particle, sphere centre
     const auto e = evalSphereContact(p[0], p[1], 0.3);
-    std::function<double(const std::array<V, 2>&)> C = [](const auto& q) { return evalSphereContact(q[0], q[1], 0.3).C; };
+    std::function<double(const std::array<V, 2>&)> C = [](const auto& q) {
+      return evalSphereContact(q[0], q[1], 0.3).C;
+    };
     expectGradientsMatch(e.n, numericGradient(C, p, 0), "fingertip contact");
   }
 }
@@ -193,7 +196,8 @@ TEST(Gradients, ColliderSignedDistance) {
       EXPECT_NEAR(s.normal.norm(), 1.0f, 1e-5f);
       // The distance changes at rate 1 along the normal (float: FD step 1e-3, tolerance 1e-2).
       const float h = 1e-3f;
-      const float slope = (closestSurface(c, p + h * s.normal).distance - closestSurface(c, p - h * s.normal).distance) / (2 * h);
+      const float slope =
+          (closestSurface(c, p + h * s.normal).distance - closestSurface(c, p - h * s.normal).distance) / (2 * h);
       EXPECT_NEAR(slope, 1.0f, 1e-2f) << "shape " << int(c.shape) << " at " << p.transpose();
     }
 }

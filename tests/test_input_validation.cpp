@@ -23,9 +23,7 @@ std::string errorOf(F&& f) {
   return {};
 }
 
-TetMesh unitTet() {
-  return {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}, {{0, 1, 2, 3}}};
-}
+TetMesh unitTet() { return {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}, {{0, 1, 2, 3}}}; }
 
 TEST(InputValidation, TetMeshErrorsNameTheElement) {
   TetMesh mesh = makeBoxTets(Vec3::Zero(), Vec3::Ones(), 2, 1, 1);
@@ -91,9 +89,9 @@ TEST(InputValidation, MaterialErrors) {
   m.elastic = ElasticModuli{1e4f, 0.3f, 0.0f};
   EXPECT_NE(errorOf([&] { makeSoftBody(mesh, m); }).find("density"), std::string::npos);
   m.elastic = ElasticModuli{1e4f, 0.3f, 1000.0f};
-  EXPECT_NE(errorOf([&] { makeCloth(makeGridCloth(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), 2, 2), m); })
-                .find("cloth"),
-            std::string::npos);
+  EXPECT_NE(
+      errorOf([&] { makeCloth(makeGridCloth(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), 2, 2), m); }).find("cloth"),
+      std::string::npos);
 }
 
 TEST(InputValidation, HandBuiltModelErrorsNameTheItem) {

@@ -94,7 +94,8 @@ TEST(Lanes, VolumeAndStrainKernelsMatchScalar) {
     w[k] = in.lanes([&](int l) { return in.w[l][k]; });
   }
   const float invH = 60.0f;
-  const auto k4 = XpbdCoefficientsT<Lane4>::make(in.lanes([&](int l) { return in.compliance[l]; }), splat<Lane4>(0.002), invH);
+  const auto k4 =
+      XpbdCoefficientsT<Lane4>::make(in.lanes([&](int l) { return in.compliance[l]; }), splat<Lane4>(0.002), invH);
   const auto vol = solveVolume(x, w, in.lanes([&](int l) { return in.restVolume[l]; }),
                                in.lanes([&](int l) { return in.lambda[l][0]; }), k4, disp);
   for (int k = 0; k < 3; ++k) {
@@ -126,8 +127,8 @@ TEST(Lanes, WorldWithAndWithoutSimdAgree) {
   // The same Gauss-Seidel order either way; only the rounding of identical operations may differ.
   Material m;
   m.elastic = ElasticModuli{2e4f, 0.4f, 1000.0f, 0.001f};
-  const auto model = makeSoftBody(makeBoxTets(Vec3(-0.05f, 0.0f, -0.05f), Vec3::Constant(0.1f), 4, 4, 4), m,
-                                  {true, true, true, true});
+  const auto model =
+      makeSoftBody(makeBoxTets(Vec3(-0.05f, 0.0f, -0.05f), Vec3::Constant(0.1f), 4, 4, 4), m, {true, true, true, true});
   std::vector<Vec3> result[2];
   for (int simd = 0; simd < 2; ++simd) {
     SolverSettings s;
@@ -136,7 +137,8 @@ TEST(Lanes, WorldWithAndWithoutSimdAgree) {
     const BodyId b = w.addBody(model, Vec3(0.0f, 0.02f, 0.0f));
     w.addCollider(Collider::plane(Vec3::UnitY()));
     for (int step = 0; step < 60; ++step) w.step();
-    for (Index i = 0; i < model->particleCount(); ++i) result[simd].push_back(w.particles().x[w.particleIndex(b, i)].pos);
+    for (Index i = 0; i < model->particleCount(); ++i)
+      result[simd].push_back(w.particles().x[w.particleIndex(b, i)].pos);
   }
   for (Index i = 0; i < model->particleCount(); ++i) EXPECT_LT((result[0][i] - result[1][i]).norm(), 1e-5f) << i;
 }

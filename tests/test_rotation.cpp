@@ -59,10 +59,10 @@ TEST(Rotation, DegenerateAndInvertedInputGiveProperRotations) {
   for (int trial = 0; trial < 100; ++trial) {
     const Md R = randomRotation(rng).toRotationMatrix();
     const Md cases[] = {
-        R * Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal(),    // flattened to a plane
-        R * Eigen::Vector3d(1.0, 0.0, 0.0).asDiagonal(),    // collapsed to a line
-        R * Eigen::Vector3d(1.0, 1.0, -1.0).asDiagonal(),   // mirrored (det < 0)
-        R * Eigen::Vector3d(-1.0, -1.0, -1.0).asDiagonal(), // point reflection
+        R * Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal(),     // flattened to a plane
+        R * Eigen::Vector3d(1.0, 0.0, 0.0).asDiagonal(),     // collapsed to a line
+        R * Eigen::Vector3d(1.0, 1.0, -1.0).asDiagonal(),    // mirrored (det < 0)
+        R * Eigen::Vector3d(-1.0, -1.0, -1.0).asDiagonal(),  // point reflection
         Md::Zero(),
     };
     for (const Md& A : cases) {

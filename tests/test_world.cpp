@@ -22,7 +22,8 @@ TEST(World, NanIsContainedInItsBodyAndReported) {
   const BodyId healthy = w.addBody(smallJelly(), Vec3(1.0f, 1.0f, 0.0f));
   for (int s = 0; s < 5; ++s) w.step();
   std::vector<Vec3> before;
-  for (Index i = 0; i < w.body(sick).particleCount; ++i) before.push_back(w.particles().x[w.particleIndex(sick, i)].pos);
+  for (Index i = 0; i < w.body(sick).particleCount; ++i)
+    before.push_back(w.particles().x[w.particleIndex(sick, i)].pos);
   const float healthyY = w.particles().x[w.particleIndex(healthy, 0)].pos.y();
 
   w.particles().force[w.particleIndex(sick, 3)] = Vec3(std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f);
@@ -88,6 +89,21 @@ TEST(World, KinematicParticlesFollowTheirVelocity) {
   EXPECT_LT((w.particles().x[k].pos - start - Vec3(0.1f, 0.0f, 0.0f)).norm(), 1e-6f);
 }
 
+TEST(World, ConstantForceAcceleratesByForceOverMass) {
+  // Algorithm 1, line 7: a = w f on top of gravity; a free 2 kg particle under 20 N along x.
+  SolverSettings s;
+  s.substeps = 2;
+  World w(s);
+  auto model = std::make_shared<BodyModel>();
+  model->restPositions = {Vec3::Zero()};
+  model->invMass = {0.5f};
+  const BodyId b = w.addBody(model);
+  w.setExternalForce(b, Vec3(20.0f, 0.0f, 0.0f));
+  for (int i = 0; i < 60; ++i) w.step();
+  EXPECT_NEAR(w.particles().v[0].x(), 10.0f, 1e-4f);  // 10 m/s^2 for 1 s
+  EXPECT_NEAR(w.particles().v[0].y(), -9.81f, 1e-4f);
+}
+
 TEST(World, MovingAttachmentArrivesAtItsGoal) {
   for (int substeps : {1, 3}) {
     SolverSettings s;
@@ -118,8 +134,8 @@ TEST(World, StageTimesCoverTheStagesThatRan) {
   w.addFingertip(Vec3(0.0f, 0.12f, 0.0f), 0.03f);
   w.step();
   const StageTimes& t = w.lastStep().times;
-  for (Stage s : {Stage::Predict, Stage::Detect, Stage::Volume, Stage::Strain, Stage::ShapeMatching,
-                  Stage::Attachment, Stage::Finalise})
+  for (Stage s : {Stage::Predict, Stage::Detect, Stage::Volume, Stage::Strain, Stage::ShapeMatching, Stage::Attachment,
+                  Stage::Finalise})
     EXPECT_GT(t[s], 0.0) << stageName(s);
   EXPECT_EQ(t[Stage::Distance], 0.0);  // no such constraints
   EXPECT_EQ(t[Stage::Bend], 0.0);
@@ -152,7 +168,8 @@ TEST(World, BodiesSharingAModelAreIndependent) {
   for (int i = 0; i < 10; ++i) w.step();
   // b stays at rest (up to the float rounding of its translated rest shape) while a moves 0.17 m.
   for (Index i = 0; i < w.body(b).particleCount; ++i)
-    EXPECT_LT((w.particles().x[w.particleIndex(b, i)].pos - Vec3(1.0f, 0.0f, 0.0f) - model->restPositions[i]).norm(), 1e-6f);
+    EXPECT_LT((w.particles().x[w.particleIndex(b, i)].pos - Vec3(1.0f, 0.0f, 0.0f) - model->restPositions[i]).norm(),
+              1e-6f);
   EXPECT_GT((w.particles().x[w.particleIndex(a, 0)].pos - model->restPositions[0]).norm(), 0.1f);
 }
 

@@ -8,7 +8,7 @@ namespace vrd {
 
 /// Invalid input (mesh, material, settings, API argument). The message says what and where.
 class Error : public std::runtime_error {
-public:
+ public:
   using std::runtime_error::runtime_error;
 };
 

@@ -49,7 +49,8 @@ TriMesh makeGridCloth(const Vec3& origin, const Vec3& uAxis, const Vec3& vAxis, 
   if (nu < 1 || nv < 1) throw Error("makeGridCloth: cell counts must be at least 1");
   TriMesh mesh;
   for (int iv = 0; iv <= nv; ++iv)
-    for (int iu = 0; iu <= nu; ++iu) mesh.vertices.push_back(origin + uAxis * (float(iu) / nu) + vAxis * (float(iv) / nv));
+    for (int iu = 0; iu <= nu; ++iu)
+      mesh.vertices.push_back(origin + uAxis * (float(iu) / nu) + vAxis * (float(iv) / nv));
   auto id = [&](int iu, int iv) { return Index(iv * (nu + 1) + iu); };
   for (int iv = 0; iv < nv; ++iv)
     for (int iu = 0; iu < nu; ++iu) {

@@ -12,16 +12,16 @@ namespace {
 void checkVertices(const std::vector<Vec3>& vertices) {
   for (std::size_t v = 0; v < vertices.size(); ++v)
     if (!isFinite(vertices[v]))
-      throw Error(fmt::format("vertex {} has a non-finite coordinate ({}, {}, {})", v, vertices[v].x(),
-                              vertices[v].y(), vertices[v].z()));
+      throw Error(fmt::format("vertex {} has a non-finite coordinate ({}, {}, {})", v, vertices[v].x(), vertices[v].y(),
+                              vertices[v].z()));
 }
 
 template <std::size_t N>
 void checkIndices(const char* what, std::size_t element, const std::array<Index, N>& idx, std::size_t vertexCount) {
   for (std::size_t k = 0; k < N; ++k) {
     if (idx[k] >= vertexCount)
-      throw Error(fmt::format("{} {} refers to vertex {}, but there are only {} vertices", what, element, idx[k],
-                              vertexCount));
+      throw Error(
+          fmt::format("{} {} refers to vertex {}, but there are only {} vertices", what, element, idx[k], vertexCount));
     for (std::size_t j = 0; j < k; ++j)
       if (idx[j] == idx[k])
         throw Error(fmt::format("{} {} uses vertex {} twice ({})", what, element, idx[k], fmt::join(idx, ", ")));

@@ -17,7 +17,7 @@ bool finiteNonNegative(float v) { return std::isfinite(v) && v >= 0.0f; }
 
 void validateMaterial(const Material& m) {
   const std::pair<const char*, const ConstraintMaterial*> types[] = {
-      {"distance", &m.distance},          {"volume", &m.volume},
+      {"distance", &m.distance},           {"volume", &m.volume},
       {"strainStretch", &m.strainStretch}, {"strainShear", &m.strainShear},
       {"shapeMatching", &m.shapeMatching}, {"bending", &m.bending}};
   for (const auto& [name, c] : types) {
@@ -59,8 +59,8 @@ template <std::size_t N>
 void checkItem(const char* what, std::size_t item, const Index (&idx)[N], std::size_t particles, float compliance) {
   for (std::size_t k = 0; k < N; ++k) {
     if (idx[k] >= particles)
-      throw Error(fmt::format("{} {} refers to particle {}, but the body has {} particles", what, item, idx[k],
-                              particles));
+      throw Error(
+          fmt::format("{} {} refers to particle {}, but the body has {} particles", what, item, idx[k], particles));
     for (std::size_t j = 0; j < k; ++j)
       if (idx[j] == idx[k]) throw Error(fmt::format("{} {} uses particle {} twice", what, item, idx[k]));
   }
@@ -76,7 +76,8 @@ void checkAll(const char* what, const std::vector<C>& items, std::size_t particl
 template <typename C>
 std::vector<std::array<Index, std::extent_v<decltype(C::i)>>> particlesOf(const std::vector<C>& constraints) {
   std::vector<std::array<Index, std::extent_v<decltype(C::i)>>> out(constraints.size());
-  for (std::size_t c = 0; c < constraints.size(); ++c) std::copy(std::begin(constraints[c].i), std::end(constraints[c].i), out[c].begin());
+  for (std::size_t c = 0; c < constraints.size(); ++c)
+    std::copy(std::begin(constraints[c].i), std::end(constraints[c].i), out[c].begin());
   return out;
 }
 
@@ -177,12 +178,12 @@ std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Materia
     std::map<Edge, double> edgeVolume;  // each tet lends a sixth of its volume to each of its edges
     for (std::size_t t = 0; t < model->tets.size(); ++t)
       for (int a = 0; a < 4; ++a)
-        for (int b = a + 1; b < 4; ++b) edgeVolume[sortedEdge(model->tets[t][a], model->tets[t][b])] += restVolume[t] / 6.0;
+        for (int b = a + 1; b < 4; ++b)
+          edgeVolume[sortedEdge(model->tets[t][a], model->tets[t][b])] += restVolume[t] / 6.0;
     for (const auto& [edge, volume] : edgeVolume) {
       const double length = (mesh.vertices[edge.first] - mesh.vertices[edge.second]).cast<double>().norm();
-      const float compliance = material.elastic
-                                   ? float(length * length / (material.elastic->youngsModulus * volume))
-                                   : material.distance.compliance;
+      const float compliance = material.elastic ? float(length * length / (material.elastic->youngsModulus * volume))
+                                                : material.distance.compliance;
       model->distance.push_back({{edge.first, edge.second}, float(length), compliance});
     }
   }
@@ -256,8 +257,7 @@ void validateModel(const BodyModel& model) {
   if (model.invMass.size() != n)
     throw Error(fmt::format("body model has {} inverse masses for {} particles", model.invMass.size(), n));
   for (std::size_t i = 0; i < n; ++i) {
-    if (!isFinite(model.restPositions[i]))
-      throw Error(fmt::format("particle {} has a non-finite rest position", i));
+    if (!isFinite(model.restPositions[i])) throw Error(fmt::format("particle {} has a non-finite rest position", i));
     if (!finiteNonNegative(model.invMass[i]))
       throw Error(fmt::format("particle {} has inverse mass {}; masses must be positive (inverse mass 0 = kinematic)",
                               i, model.invMass[i]));

@@ -12,8 +12,10 @@
 
 namespace vrd::sweeps {
 
-template <typename T> inline constexpr std::size_t kWidth = std::is_same_v<T, Lane4> ? kLanes : 1;
-template <typename T> using VecOf = std::conditional_t<std::is_same_v<T, Lane4>, V3<Lane4>, Vec3>;
+template <typename T>
+inline constexpr std::size_t kWidth = std::is_same_v<T, Lane4> ? kLanes : 1;
+template <typename T>
+using VecOf = std::conditional_t<std::is_same_v<T, Lane4>, V3<Lane4>, Vec3>;
 
 /// The N particles of one constraint (T = float) or of kLanes constraints (T = Lane4), with their
 /// inverse masses and, when damped, their motion since the start of the substep.
@@ -43,7 +45,7 @@ struct Gathered {
     for (std::size_t a = 0; a < N; ++a) add(pred, idx[a], dp[a]);
   }
 
-private:
+ private:
   static void load(const Point* pts, const Index (&i)[1], Vec3& x, float& w) {
     x = pts[i[0]].pos;
     w = pts[i[0]].w;
@@ -102,7 +104,8 @@ void distance(const DistanceConstraint* c, std::size_t begin, std::size_t end, f
               const Range& r) {
   for (std::size_t i = begin; i < end; i += kWidth<T>) {
     const Gathered<T, 2, Damped> g(c + i, r.pred, r.start);
-    const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &DistanceConstraint::compliance), splat<T>(tau), r.invH);
+    const auto k =
+        XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &DistanceConstraint::compliance), splat<T>(tau), r.invH);
     const auto out = solveDistance(g.x, g.w, fieldOf<T>(c + i, &DistanceConstraint::restLength),
                                    loadLambda<T>(lambda + i), k, g.displacement());
     addLambda(lambda + i, out.dLambda);
@@ -115,8 +118,8 @@ void volume(const VolumeConstraint* c, std::size_t begin, std::size_t end, float
   for (std::size_t i = begin; i < end; i += kWidth<T>) {
     const Gathered<T, 4, Damped> g(c + i, r.pred, r.start);
     const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &VolumeConstraint::compliance), splat<T>(tau), r.invH);
-    const auto out = solveVolume(g.x, g.w, fieldOf<T>(c + i, &VolumeConstraint::restVolume),
-                                 loadLambda<T>(lambda + i), k, g.displacement());
+    const auto out = solveVolume(g.x, g.w, fieldOf<T>(c + i, &VolumeConstraint::restVolume), loadLambda<T>(lambda + i),
+                                 k, g.displacement());
     addLambda(lambda + i, out.dLambda);
     g.scatter(out.dp, r.pred);
   }

@@ -7,8 +7,8 @@
 #include <type_traits>
 #include <utility>
 
-#include "vrdeform/error.h"
 #include "sweeps.h"
+#include "vrdeform/error.h"
 
 namespace vrd {
 namespace {
@@ -107,8 +107,15 @@ void World::resetBody(BodyId id) {
 
 void World::setInverseMass(Index particle, float w) {
   if (particle >= particles_.size()) throw Error(fmt::format("setInverseMass: no particle {}", particle));
-  if (!(std::isfinite(w) && w >= 0.0f)) throw Error(fmt::format("setInverseMass: inverse mass must be >= 0, got {}", w));
+  if (!(std::isfinite(w) && w >= 0.0f))
+    throw Error(fmt::format("setInverseMass: inverse mass must be >= 0, got {}", w));
   particles_.x[particle].w = particles_.p[particle].w = w;
+}
+
+void World::setExternalForce(BodyId id, const Vec3& force) {
+  checkFinite(force, "setExternalForce");
+  const Body& b = bodies_.at(id);
+  std::fill_n(particles_.force.begin() + b.firstParticle, b.particleCount, force);
 }
 
 AttachmentId World::attach(Index particle, const Vec3& target, float compliance, const Vec3& axes, float damping) {
@@ -152,7 +159,8 @@ ColliderId World::addCollider(const Collider& collider) {
 
 FingertipId World::addFingertip(const Vec3& center, float radius, float compliance) {
   checkFinite(center, "addFingertip centre");
-  if (!(std::isfinite(radius) && radius > 0.0f)) throw Error(fmt::format("addFingertip: radius must be positive, got {}", radius));
+  if (!(std::isfinite(radius) && radius > 0.0f))
+    throw Error(fmt::format("addFingertip: radius must be positive, got {}", radius));
   checkCompliance(compliance, "addFingertip");
   fingertips_.push_back({center, center, radius, compliance});
   return FingertipId(fingertips_.size() - 1);
@@ -169,7 +177,8 @@ Vec3 World::fingertipForce(FingertipId id) const {
   const Fingertip& f = fingertips_.at(id);
   for (std::size_t c = 0; c < fingertipContacts_.size(); ++c)
     if (fingertipContacts_[c].fingertip == id)
-      force += fingertipLambda_[c] * evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, f.center, f.radius).n;
+      force += fingertipLambda_[c] *
+               evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, f.center, f.radius).n;
   return force / (h * h);
 }
 
@@ -232,7 +241,8 @@ void World::detectContacts(float /*h*/) {
       // contacts are inequalities, so candidates that stay clear cost a check and do nothing.
       const float motion = (p.pos - particles_.x[i].pos).norm();
       for (Index c = 0; c < colliders_.size(); ++c)
-        if (closestSurface(colliders_[c], p.pos).distance < radius + motion) colliderContacts_.push_back({i, c, radius});
+        if (closestSurface(colliders_[c], p.pos).distance < radius + motion)
+          colliderContacts_.push_back({i, c, radius});
       // Eq. 36: N(r) from the predicted positions, widened by the same margin plus a skin, so that
       // a particle resting on the fingertip is not dropped when its prediction lands just outside.
       for (Index f = 0; f < fingertips_.size(); ++f) {
@@ -284,7 +294,8 @@ void World::solveIteration(float h) {
       StageTimer t(times, Stage::Strain, timed);
       sweeps::widths(simd, m.batchedStrain, m.strain.size(), tau.strainStretch > 0.0f || tau.strainShear > 0.0f,
                      [&](auto damped, auto width, std::size_t begin, std::size_t end) {
-                       sweeps::strain<decltype(width), damped>(m.strain.data(), begin, end, b.strainLambda.data(), tau, r);
+                       sweeps::strain<decltype(width), damped>(m.strain.data(), begin, end, b.strainLambda.data(), tau,
+                                                               r);
                      });
     }
     if (!m.volume.empty()) {
@@ -316,9 +327,9 @@ void World::solveIteration(float h) {
       const Attachment& at = attachments_[a];
       if (at.particle == kNoParticle) continue;
       Point& q = pred[at.particle];
-      const Vec3 dLambda = solveAttachment(q, at.target, at.axes, attachmentLambda_[a],
-                                           XpbdCoefficients::make(at.compliance, at.dampingTime, invH),
-                                           q.pos - start[at.particle].pos);
+      const Vec3 dLambda =
+          solveAttachment(q, at.target, at.axes, attachmentLambda_[a],
+                          XpbdCoefficients::make(at.compliance, at.dampingTime, invH), q.pos - start[at.particle].pos);
       attachmentLambda_[a] += dLambda;
       q.pos += q.w * dLambda;
     }
@@ -344,7 +355,7 @@ void World::solveIteration(float h) {
       const Fingertip& f = fingertips_[con.fingertip];
       Point& q = pred[con.particle];
       const Correction<Vec3, 1> r = solveFingertipContact(q, f.center, f.radius, fingertipLambda_[c],
-                                                    XpbdCoefficients::make(f.compliance, 0.0f, invH));
+                                                          XpbdCoefficients::make(f.compliance, 0.0f, invH));
       fingertipLambda_[c] += r.dLambda;
       q.pos += r.dp[0];
     }
@@ -376,9 +387,10 @@ void World::containNonFinite(BodyId id) {
   Index first = b.firstParticle;
   while (isFinite(particles_.p[first].pos)) ++first;
   bool lastStateFinite = true;  // the committed positions; velocities are zeroed anyway
-  for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) lastStateFinite &= isFinite(particles_.x[i].pos);
-  const std::string what = fmt::format("body {}: non-finite position of particle {} in step {}", id,
-                                       first - b.firstParticle, stepCount_);
+  for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i)
+    lastStateFinite &= isFinite(particles_.x[i].pos);
+  const std::string what =
+      fmt::format("body {}: non-finite position of particle {} in step {}", id, first - b.firstParticle, stepCount_);
   if (settings_.onNan == NanPolicy::Freeze && lastStateFinite) {
     for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
       particles_.p[i].pos = particles_.x[i].pos;
@@ -397,8 +409,8 @@ double World::volume(BodyId id) const {
   const Point* x = particles_.x.data() + b.firstParticle;
   double sum = 0.0;
   for (const Tet& t : b.model->tets)
-    sum += signedTetVolume<double>(x[t[0]].pos.cast<double>(), x[t[1]].pos.cast<double>(),
-                                   x[t[2]].pos.cast<double>(), x[t[3]].pos.cast<double>());
+    sum += signedTetVolume<double>(x[t[0]].pos.cast<double>(), x[t[1]].pos.cast<double>(), x[t[2]].pos.cast<double>(),
+                                   x[t[3]].pos.cast<double>());
   return sum;
 }
 
@@ -443,20 +455,23 @@ std::vector<Vec3> World::particleConstraintForces(BodyId id) const {
 
   auto local = [&](Index particle) -> Vec3* {
     return particle >= b.firstParticle && particle < b.firstParticle + b.particleCount ? &f[particle - b.firstParticle]
-                                                                                        : nullptr;
+                                                                                       : nullptr;
   };
   for (std::size_t a = 0; a < attachments_.size(); ++a)
     if (Vec3* fi = attachments_[a].particle == kNoParticle ? nullptr : local(attachments_[a].particle))
       *fi += attachmentLambda_[a] * invH2;
   for (std::size_t c = 0; c < colliderContacts_.size(); ++c)
     if (Vec3* fi = local(colliderContacts_[c].particle)) {
-      const Vec3 n = closestSurface(colliders_[colliderContacts_[c].collider], particles_.x[colliderContacts_[c].particle].pos).normal;
+      const Vec3 n =
+          closestSurface(colliders_[colliderContacts_[c].collider], particles_.x[colliderContacts_[c].particle].pos)
+              .normal;
       *fi += (contactNormalLambda_[c] * n + contactFrictionLambda_[c]) * invH2;
     }
   for (std::size_t c = 0; c < fingertipContacts_.size(); ++c)
     if (Vec3* fi = local(fingertipContacts_[c].particle)) {
       const Fingertip& tip = fingertips_[fingertipContacts_[c].fingertip];
-      *fi += fingertipLambda_[c] * invH2 * evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, tip.center, tip.radius).n;
+      *fi += fingertipLambda_[c] * invH2 *
+             evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, tip.center, tip.radius).n;
     }
   return f;
 }

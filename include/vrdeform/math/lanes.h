@@ -5,22 +5,29 @@
 // paths cannot drift apart. The member names follow Eigen's so that the same kernels also accept
 // Eigen vectors.
 
-#include <cmath>
 #include <xmmintrin.h>
+#include <cmath>
 
 namespace vrd {
 
 /// Four floats processed together (GCC/Clang vector extension; SSE on any x86-64).
 using Lane4 = float __attribute__((vector_size(16)));
 
-template <typename T> T splat(double v) { return T(v); }
-template <> inline Lane4 splat<Lane4>(double v) {
+template <typename T>
+T splat(double v) {
+  return T(v);
+}
+template <>
+inline Lane4 splat<Lane4>(double v) {
   const float f = float(v);
   return Lane4{f, f, f, f};
 }
 
 /// Per-lane choice: `mask ? a : b` (mask is a bool for scalars and a lane mask for Lane4).
-template <typename M, typename T> T select(M mask, T a, T b) { return mask ? a : b; }
+template <typename M, typename T>
+T select(M mask, T a, T b) {
+  return mask ? a : b;
+}
 
 inline float sqrt(float v) { return std::sqrt(v); }
 inline double sqrt(double v) { return std::sqrt(v); }

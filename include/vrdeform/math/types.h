@@ -9,8 +9,10 @@
 
 namespace vrd {
 
-template <typename S> using Vec3T = Eigen::Matrix<S, 3, 1>;
-template <typename S> using Mat3T = Eigen::Matrix<S, 3, 3>;
+template <typename S>
+using Vec3T = Eigen::Matrix<S, 3, 1>;
+template <typename S>
+using Mat3T = Eigen::Matrix<S, 3, 3>;
 
 using Vec3 = Vec3T<float>;
 using Mat3 = Mat3T<float>;

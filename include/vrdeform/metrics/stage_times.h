@@ -39,7 +39,7 @@ struct StageTimes {
 
 /// Adds the time between construction and destruction to one stage; does nothing when disabled.
 class StageTimer {
-public:
+ public:
   StageTimer(StageTimes& times, Stage stage, bool enabled)
       : slot_(enabled ? &times[stage] : nullptr), start_(enabled ? Clock::now() : Clock::time_point{}) {}
   ~StageTimer() {
@@ -48,7 +48,7 @@ public:
   StageTimer(const StageTimer&) = delete;
   StageTimer& operator=(const StageTimer&) = delete;
 
-private:
+ private:
   using Clock = std::chrono::steady_clock;
   double* slot_;
   Clock::time_point start_;

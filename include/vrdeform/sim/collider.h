@@ -11,14 +11,14 @@ enum class ColliderShape : std::uint8_t { Plane, Sphere, Box };
 
 struct Collider {
   ColliderShape shape = ColliderShape::Plane;
-  Vec3 center = Vec3::Zero();         ///< plane: a point on it; sphere and box: the centre
-  Vec3 normal = Vec3::UnitY();        ///< plane: unit normal pointing to the free side
-  float radius = 0.0f;                ///< sphere radius
-  Vec3 halfExtents = Vec3::Zero();    ///< box half sizes along its local axes
-  Mat3 rotation = Mat3::Identity();   ///< box: local-to-world rotation
-  float staticFriction = 0.5f;        ///< Coulomb mu_s: sticks while |f_t| <= mu_s f_n
-  float dynamicFriction = 0.4f;       ///< Coulomb mu_k: sliding friction force = mu_k f_n
-  float compliance = 0.0f;            ///< alpha of the normal contact (m/N); 0 = rigid
+  Vec3 center = Vec3::Zero();        ///< plane: a point on it; sphere and box: the centre
+  Vec3 normal = Vec3::UnitY();       ///< plane: unit normal pointing to the free side
+  float radius = 0.0f;               ///< sphere radius
+  Vec3 halfExtents = Vec3::Zero();   ///< box half sizes along its local axes
+  Mat3 rotation = Mat3::Identity();  ///< box: local-to-world rotation
+  float staticFriction = 0.5f;       ///< Coulomb mu_s: sticks while |f_t| <= mu_s f_n
+  float dynamicFriction = 0.4f;      ///< Coulomb mu_k: sliding friction force = mu_k f_n
+  float compliance = 0.0f;           ///< alpha of the normal contact (m/N); 0 = rigid
 
   static Collider plane(const Vec3& normal, const Vec3& pointOnPlane = Vec3::Zero());
   static Collider sphere(const Vec3& center, float radius);

@@ -13,8 +13,8 @@ namespace vrd {
 inline constexpr std::size_t kLanes = 4;
 
 struct LaneOrder {
-  std::vector<Index> order;   ///< a permutation of the constraints
-  std::size_t batched = 0;    ///< order[0, batched) forms groups of kLanes independent constraints
+  std::vector<Index> order;  ///< a permutation of the constraints
+  std::size_t batched = 0;   ///< order[0, batched) forms groups of kLanes independent constraints
 };
 
 /// Greedy packing within a sliding window, so the order stays close to the input order (which

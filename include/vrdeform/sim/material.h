@@ -18,11 +18,11 @@ struct ConstraintMaterial {
 /// so that volume + strain constraints reproduce isotropic linear elasticity at small strain, and
 /// lumps particle masses from the density.
 struct ElasticModuli {
-  float youngsModulus;          ///< E (Pa)
-  float poissonRatio;           ///< nu, in [0, 0.5)
-  float density;                ///< rho (kg/m^3)
-  float rayleighDamping = 0.0f; ///< stiffness-proportional damping time tau (s); a mode of angular
-                                ///< frequency w gets damping ratio w tau / 2
+  float youngsModulus;           ///< E (Pa)
+  float poissonRatio;            ///< nu, in [0, 0.5)
+  float density;                 ///< rho (kg/m^3)
+  float rayleighDamping = 0.0f;  ///< stiffness-proportional damping time tau (s); a mode of angular
+                                 ///< frequency w gets damping ratio w tau / 2
 };
 
 struct Material {

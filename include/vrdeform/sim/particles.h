@@ -15,10 +15,10 @@ struct alignas(16) Point {
 };
 
 struct Particles {
-  std::vector<Point> x;      ///< positions at the start of the (sub)step; x[i].w is the inverse mass
-  std::vector<Point> p;      ///< predicted positions that the constraints correct; p[i].w mirrors x[i].w
-  std::vector<Vec3> v;       ///< velocities (m/s)
-  std::vector<Vec3> force;   ///< constant external force on each particle (N), e.g. wind
+  std::vector<Point> x;     ///< positions at the start of the (sub)step; x[i].w is the inverse mass
+  std::vector<Point> p;     ///< predicted positions that the constraints correct; p[i].w mirrors x[i].w
+  std::vector<Vec3> v;      ///< velocities (m/s)
+  std::vector<Vec3> force;  ///< constant external force on each particle (N), e.g. wind
 
   std::size_t size() const { return x.size(); }
 };

@@ -26,7 +26,7 @@ struct ShapeMatchModel {
   std::vector<Vec3> restOffsets;  ///< x_i - c1, one per particle of the body
   std::vector<float> mass;        ///< m_i, the weights of eq. 25
   float totalMass;
-  float compliance;               ///< alpha (m/N for a 1 kg particle; see above)
+  float compliance;  ///< alpha (m/N for a 1 kg particle; see above)
 };
 
 struct ShapeMatchFrame {

@@ -25,7 +25,8 @@ inline constexpr int kStrainAxes[kStrainComponents][2] = {{0, 0}, {1, 1}, {2, 2}
 inline bool isStretchComponent(int c) { return c < 3; }
 
 /// The six multipliers of a tet's strain constraints, in component order.
-template <typename T> using StrainLambdaT = std::array<T, kStrainComponents>;
+template <typename T>
+using StrainLambdaT = std::array<T, kStrainComponents>;
 using StrainLambda = StrainLambdaT<float>;
 
 /// Per-particle weights a_k with F = sum_k p_k a_k^T: a_k is row k-1 of D_rest^-1 and
@@ -91,12 +92,12 @@ StrainCorrection<V> solveStrain(const V (&x)[4], const typename V::Scalar (&w)[4
   for (int i = 0; i < 3; ++i) {
     f[i] = a[0][i] * x[0] + a[1][i] * x[1] + a[2][i] * x[2] + a[3][i] * x[3];
     // grad C . disp = f_j.D_i + f_i.D_j with the displacement gradient D = F - F(start).
-    fStart[i] = disp ? V(f[i] - (a[0][i] * disp[0] + a[1][i] * disp[1] + a[2][i] * disp[2] + a[3][i] * disp[3]))
-                     : V(V::Zero());
+    fStart[i] =
+        disp ? V(f[i] - (a[0][i] * disp[0] + a[1][i] * disp[1] + a[2][i] * disp[2] + a[3][i] * disp[3])) : V(V::Zero());
     U[i] = V::Zero();
     for (int j = i; j < 3; ++j)
-      B[i][j] = B[j][i] = w[0] * a[0][i] * a[0][j] + w[1] * a[1][i] * a[1][j] + w[2] * a[2][i] * a[2][j] +
-                          w[3] * a[3][i] * a[3][j];
+      B[i][j] = B[j][i] =
+          w[0] * a[0][i] * a[0][j] + w[1] * a[1][i] * a[1][j] + w[2] * a[2][i] * a[2][j] + w[3] * a[3][i] * a[3][j];
   }
 
   StrainCorrection<V> out;

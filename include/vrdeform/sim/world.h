@@ -34,7 +34,7 @@ struct StepReport {
 };
 
 class World {
-public:
+ public:
   explicit World(const SolverSettings& settings = {});
 
   const SolverSettings& settings() const { return settings_; }
@@ -58,6 +58,8 @@ public:
   Index particleIndex(BodyId body, Index local) const { return bodies_.at(body).firstParticle + local; }
   /// Sets a particle's inverse mass; 0 makes it kinematic.
   void setInverseMass(Index particle, float w);
+  /// Applies the same constant force (N) to every particle of a body, e.g. the flag's wind.
+  void setExternalForce(BodyId id, const Vec3& force);
 
   // --- Attachments -----------------------------------------------------------------------------
   /// Holds a particle at `target` along the world axes set in `axes` (1 = held).
@@ -109,7 +111,7 @@ public:
   /// attachments and contacts. At rest it balances the particle's weight and external force.
   std::vector<Vec3> particleConstraintForces(BodyId id) const;
 
-private:
+ private:
   void predict(float h);
   void detectContacts(float h);
   void resetMultipliers();
