@@ -40,9 +40,11 @@ void runSteps(benchmark::State& state, const TetMesh& mesh, const ConstraintSet&
     if (model->restPositions[i].z() < 1e-6f) world.setInverseMass(world.particleIndex(body, i), 0.0f);
   for (int s = 0; s < 10; ++s) world.step();
   for (auto _ : state) world.step();
-  const double perStep = double(iterations) * double(model->distance.size() + model->volume.size() + model->strain.size());
+  const double perStep =
+      double(iterations) * double(model->distance.size() + model->volume.size() + model->strain.size());
   state.counters["tets"] = double(model->tets.size());
-  state.counters["tet_constraints/s"] = benchmark::Counter(perStep * double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["tet_constraints/s"] =
+      benchmark::Counter(perStep * double(state.iterations()), benchmark::Counter::kIsRate);
   state.SetLabel(simd ? "simd" : "reference loops");
 }
 
@@ -86,7 +88,8 @@ void StrainKernel(benchmark::State& state) {
         benchmark::DoNotOptimize(solveStrain(p, w, a, lambda, k, k));
       }
     }
-  state.counters["tets/s"] = benchmark::Counter(double(model->strain.size() * state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["tets/s"] =
+      benchmark::Counter(double(model->strain.size() * state.iterations()), benchmark::Counter::kIsRate);
   state.SetLabel(reference ? "step by step (re-evaluate F per component)" : "closed form");
 }
 BENCHMARK(StrainKernel)->ArgNames({"closed_form"})->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
