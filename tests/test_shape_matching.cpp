@@ -14,7 +14,7 @@ namespace {
 float rigidMismatch(const World& w, BodyId b) {
   const BodyModel& m = *w.body(b).model;
   const ShapeMatchModel& sm = *m.shapeMatching;
-  Quat q = Quat::Identity();
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
   const Point* p = w.particles().x.data() + w.body(b).firstParticle;
   const ShapeMatchFrame frame = shapeMatchFrame(p, sm, q);
   double sum = 0.0;

@@ -38,8 +38,8 @@ void sweepBend(const std::vector<BendConstraint>& constraints, float* lambda, fl
   }
 }
 
-void sweepShapeMatching(const ShapeMatchModel& sm, Vec3* lambda, Quat& rotation, Point* pred, const Point* start,
-                        float tau, float invH) {
+void sweepShapeMatching(const ShapeMatchModel& sm, Vec3* lambda, Eigen::Quaterniond& rotation, Point* pred,
+                        const Point* start, float tau, float invH) {
   const ShapeMatchFrame frame = shapeMatchFrame(pred, sm, rotation);
   const XpbdCoefficients k = XpbdCoefficients::make(sm.compliance, tau, invH);
   for (std::size_t i = 0; i < sm.restOffsets.size(); ++i) {
@@ -76,7 +76,7 @@ BodyId World::addBody(std::shared_ptr<const BodyModel> model, const Vec3& transl
   body.strainLambda.assign(model->strain.size(), StrainLambda{});
   body.bendLambda.assign(model->bend.size(), 0.0f);
   body.shapeMatchLambda.assign(model->shapeMatching ? model->particleCount() : 0, Vec3::Zero());
-  body.shapeMatchRotation = rotation;
+  body.shapeMatchRotation = rotation.cast<double>();
   for (std::size_t i = 0; i < model->particleCount(); ++i) {
     const Vec3 x = rotation * model->restPositions[i] + translation;
     body.initialPositions.push_back(x);
@@ -101,7 +101,7 @@ void World::resetBody(BodyId id) {
   std::fill(b.strainLambda.begin(), b.strainLambda.end(), StrainLambda{});
   std::fill(b.bendLambda.begin(), b.bendLambda.end(), 0.0f);
   std::fill(b.shapeMatchLambda.begin(), b.shapeMatchLambda.end(), Vec3::Zero());
-  b.shapeMatchRotation = Quat::Identity();
+  b.shapeMatchRotation = Eigen::Quaterniond::Identity();
   b.state = BodyState::Active;
 }
 

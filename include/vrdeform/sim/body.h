@@ -31,7 +31,7 @@ struct Body {
   std::vector<StrainLambda> strainLambda;
   std::vector<float> bendLambda;
   std::vector<Vec3> shapeMatchLambda;
-  Quat shapeMatchRotation = Quat::Identity();  ///< R of the last shape-matching projection (warm start)
+  Eigen::Quaterniond shapeMatchRotation = Eigen::Quaterniond::Identity();  ///< R of the last shape match (warm start)
 
   std::vector<Vec3> initialPositions;  ///< world positions at creation; resetBody() returns them at rest
 };

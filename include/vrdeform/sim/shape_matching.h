@@ -35,18 +35,20 @@ struct ShapeMatchFrame {
 };
 
 /// Eqs. 25-27: centroid and best-fit rotation of the current positions. `rotation` warm-starts
-/// the extraction and receives the result.
-inline ShapeMatchFrame shapeMatchFrame(const Point* p, const ShapeMatchModel& model, Quat& rotation) {
+/// the extraction and receives the result. In double: a rotation that stops short by float's
+/// 1e-6 rad lags a spinning body, and the goals would then brake the spin every projection.
+inline ShapeMatchFrame shapeMatchFrame(const Point* p, const ShapeMatchModel& model, Eigen::Quaterniond& rotation) {
   const std::size_t n = model.restOffsets.size();
-  Vec3 weighted = Vec3::Zero();
-  Mat3 Apq = Mat3::Zero();
+  Vec3T<double> weighted = Vec3T<double>::Zero();
+  Mat3T<double> Apq = Mat3T<double>::Zero();
   for (std::size_t i = 0; i < n; ++i) {
-    weighted += model.mass[i] * p[i].pos;
+    const Vec3T<double> mp = double(model.mass[i]) * p[i].pos.cast<double>();
+    weighted += mp;
     // sum_i m_i (p_i - c2) q_i^T = sum_i m_i p_i q_i^T because sum_i m_i q_i = 0.
-    Apq.noalias() += (model.mass[i] * p[i].pos) * model.restOffsets[i].transpose();
+    Apq.noalias() += mp * model.restOffsets[i].cast<double>().transpose();
   }
   extractRotation(Apq, rotation);
-  return {weighted / model.totalMass, rotation.toRotationMatrix()};
+  return {(weighted / double(model.totalMass)).cast<float>(), rotation.toRotationMatrix().cast<float>()};
 }
 
 /// Eq. 28 for one particle: the change of its vector multiplier; its correction is w dLambda.
