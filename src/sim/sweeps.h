@@ -1,8 +1,8 @@
 #pragma once
-// One Gauss-Seidel sweep per constraint type over a body, written once for lane width 1 (float,
-// Eigen vectors) and 4 (Lane4, V3<Lane4>). A sweep over [begin, end) with T = Lane4 takes four
-// consecutive, independent constraints at a time (lane_batches.h), which is the same sweep as
-// taking them one by one.
+// One Gauss-Seidel sweep per constraint type over a body. Distance, volume and strain are written
+// once for lane width 1 (float, Eigen vectors) and 4 (Lane4, V3<Lane4>): with T = Lane4 a sweep
+// takes four consecutive, independent constraints at a time (lane_batches.h), which is the same
+// sweep as taking them one by one. Bending and shape matching run one at a time.
 
 #include <cstring>
 #include <type_traits>
@@ -171,8 +171,37 @@ void strain(const StrainConstraint* c, std::size_t begin, std::size_t end, Strai
   }
 }
 
-/// Runs Sweep over [0, count): four at a time over the batched prefix when simd is on, then one
-/// at a time; with the damped or undamped kernel.
+// Bending, one at a time (not batched: bending is the lighter part of a cloth).
+template <bool Damped>
+void bend(const std::vector<BendConstraint>& constraints, float* lambda, float tau, const Range& r) {
+  for (std::size_t c = 0; c < constraints.size(); ++c) {
+    const BendConstraint& con = constraints[c];
+    const Gathered<float, 4, Damped> g(&con, r.pred, r.start);
+    const auto out = solveBend(g.x, g.w, con.restAngle, lambda[c], XpbdCoefficients::make(con.compliance, tau, r.invH),
+                               g.displacement());
+    lambda[c] += out.dLambda;
+    g.scatter(out.dp, r.pred);
+  }
+}
+
+// Shape matching: the frame (eqs. 25-27) once, then every particle's goal (eq. 28).
+inline void shapeMatching(const ShapeMatchModel& sm, Vec3* lambda, Eigen::Quaterniond& rotation, float tau,
+                          const Range& r) {
+  Point* pred = r.pred;
+  const Point* start = r.start;
+  const ShapeMatchFrame frame = shapeMatchFrame(pred, sm, rotation);
+  const XpbdCoefficients k = XpbdCoefficients::make(sm.compliance, tau, r.invH);
+  for (std::size_t i = 0; i < sm.restOffsets.size(); ++i) {
+    const Vec3 goal = frame.centroid + frame.rotation * sm.restOffsets[i];
+    const Vec3 disp = tau > 0.0f ? Vec3(pred[i].pos - start[i].pos) : Vec3::Zero();
+    const Vec3 dLambda = solveShapeMatchParticle(pred[i], goal, lambda[i], k, disp);
+    lambda[i] += dLambda;
+    pred[i].pos += pred[i].w * dLambda;
+  }
+}
+
+/// Calls run(damped, width, begin, end) for the lanes over the batched prefix (when simd is on) and
+/// then one at a time over the rest; damped and width are compile-time tags.
 template <typename Run>
 void widths(bool simd, std::size_t batched, std::size_t count, bool damped, Run run) {
   const std::size_t split = simd ? batched : 0;

@@ -25,30 +25,13 @@ void checkCompliance(float compliance, const char* what) {
     throw Error(fmt::format("{}: compliance must be finite and >= 0, got {}", what, compliance));
 }
 
-// One scalar sweep over the bending constraints (not batched: bending is a cloth's lighter part).
-template <bool Damped>
-void sweepBend(const std::vector<BendConstraint>& constraints, float* lambda, float tau, const sweeps::Range& r) {
-  for (std::size_t c = 0; c < constraints.size(); ++c) {
-    const BendConstraint& con = constraints[c];
-    const sweeps::Gathered<float, 4, Damped> g(&con, r.pred, r.start);
-    const auto out = solveBend(g.x, g.w, con.restAngle, lambda[c], XpbdCoefficients::make(con.compliance, tau, r.invH),
-                               g.displacement());
-    lambda[c] += out.dLambda;
-    g.scatter(out.dp, r.pred);
-  }
-}
-
-void sweepShapeMatching(const ShapeMatchModel& sm, Vec3* lambda, Eigen::Quaterniond& rotation, Point* pred,
-                        const Point* start, float tau, float invH) {
-  const ShapeMatchFrame frame = shapeMatchFrame(pred, sm, rotation);
-  const XpbdCoefficients k = XpbdCoefficients::make(sm.compliance, tau, invH);
-  for (std::size_t i = 0; i < sm.restOffsets.size(); ++i) {
-    const Vec3 goal = frame.centroid + frame.rotation * sm.restOffsets[i];
-    const Vec3 disp = tau > 0.0f ? Vec3(pred[i].pos - start[i].pos) : Vec3::Zero();
-    const Vec3 dLambda = solveShapeMatchParticle(pred[i], goal, lambda[i], k, disp);
-    lambda[i] += dLambda;
-    pred[i].pos += pred[i].w * dLambda;
-  }
+// Zeroes a body's multipliers (Algorithm 1, line 9).
+void clearMultipliers(Body& b) {
+  std::fill(b.distanceLambda.begin(), b.distanceLambda.end(), 0.0f);
+  std::fill(b.volumeLambda.begin(), b.volumeLambda.end(), 0.0f);
+  std::fill(b.strainLambda.begin(), b.strainLambda.end(), StrainLambda{});
+  std::fill(b.bendLambda.begin(), b.bendLambda.end(), 0.0f);
+  std::fill(b.shapeMatchLambda.begin(), b.shapeMatchLambda.end(), Vec3::Zero());
 }
 
 }  // namespace
@@ -96,11 +79,7 @@ void World::resetBody(BodyId id) {
     particles_.x[g].pos = particles_.p[g].pos = b.initialPositions[i];
     particles_.v[g].setZero();
   }
-  std::fill(b.distanceLambda.begin(), b.distanceLambda.end(), 0.0f);
-  std::fill(b.volumeLambda.begin(), b.volumeLambda.end(), 0.0f);
-  std::fill(b.strainLambda.begin(), b.strainLambda.end(), StrainLambda{});
-  std::fill(b.bendLambda.begin(), b.bendLambda.end(), 0.0f);
-  std::fill(b.shapeMatchLambda.begin(), b.shapeMatchLambda.end(), Vec3::Zero());
+  clearMultipliers(b);
   b.shapeMatchRotation = Eigen::Quaterniond::Identity();
   b.state = BodyState::Active;
 }
@@ -254,13 +233,7 @@ void World::detectContacts(float /*h*/) {
 }
 
 void World::resetMultipliers() {
-  for (Body& b : bodies_) {
-    std::fill(b.distanceLambda.begin(), b.distanceLambda.end(), 0.0f);
-    std::fill(b.volumeLambda.begin(), b.volumeLambda.end(), 0.0f);
-    std::fill(b.strainLambda.begin(), b.strainLambda.end(), StrainLambda{});
-    std::fill(b.bendLambda.begin(), b.bendLambda.end(), 0.0f);
-    std::fill(b.shapeMatchLambda.begin(), b.shapeMatchLambda.end(), Vec3::Zero());
-  }
+  for (Body& b : bodies_) clearMultipliers(b);
   std::fill(attachmentLambda_.begin(), attachmentLambda_.end(), Vec3::Zero());
   contactNormalLambda_.assign(colliderContacts_.size(), 0.0f);
   contactFrictionLambda_.assign(colliderContacts_.size(), Vec3::Zero());
@@ -309,14 +282,13 @@ void World::solveIteration(float h) {
     if (!m.bend.empty()) {
       StageTimer t(times, Stage::Bend, timed);
       if (tau.bend > 0.0f)
-        sweepBend<true>(m.bend, b.bendLambda.data(), tau.bend, r);
+        sweeps::bend<true>(m.bend, b.bendLambda.data(), tau.bend, r);
       else
-        sweepBend<false>(m.bend, b.bendLambda.data(), tau.bend, r);
+        sweeps::bend<false>(m.bend, b.bendLambda.data(), tau.bend, r);
     }
     if (m.shapeMatching) {
       StageTimer t(times, Stage::ShapeMatching, timed);
-      sweepShapeMatching(*m.shapeMatching, b.shapeMatchLambda.data(), b.shapeMatchRotation, r.pred, r.start,
-                         tau.shapeMatching, invH);
+      sweeps::shapeMatching(*m.shapeMatching, b.shapeMatchLambda.data(), b.shapeMatchRotation, tau.shapeMatching, r);
     }
   }
 
