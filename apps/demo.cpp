@@ -11,8 +11,8 @@
 namespace vrd {
 namespace {
 
-constexpr float kSize = 0.1f;   // a 10 cm cube
-constexpr float kDrop = 0.05f;  // dropped from 5 cm
+constexpr float kSize = 0.1f;           // a 10 cm cube
+constexpr float kDrop = 0.05f;          // dropped from 5 cm
 constexpr float kFingerRadius = 0.02f;  // a fingertip pad: it spans several surface particles
 constexpr float kPokeStart = 1.5f, kPokeDown = 1.0f, kPokeHold = 0.5f;  // s
 constexpr float kPokeDepth = 0.03f;                                     // 3 cm into the top face
