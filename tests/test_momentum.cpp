@@ -46,25 +46,20 @@
 #include <sstream>
 #include <string>
 
+#include "test_support.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/world.h"
 
 namespace vrd {
 namespace {
 
-// Records a measured value in the test report (--gtest_output=xml).
-void record(const std::string& key, double value) {
-  std::ostringstream s;
-  s.precision(6);
-  s << value;
-  ::testing::Test::RecordProperty(key, s.str());
-}
+using testing::record;
 
-using V3 = Vec3T<double>;
+using Vd = Vec3T<double>;
 
 struct Momenta {
   double mass = 0;
-  V3 com = V3::Zero(), P = V3::Zero(), L = V3::Zero();  // L about the centre of mass
+  Vd com = Vd::Zero(), P = Vd::Zero(), L = Vd::Zero();  // L about the centre of mass
   double maxCoordinate = 0;                             // max |x| component (m)
 };
 
@@ -125,7 +120,7 @@ SpinRun simulate(const ConstraintSet& constraints, float linearDamping, double s
   Material material;
   material.elastic = ElasticModuli{1e4f, 0.3f, 1000.0f};  // no Rayleigh damping by default
   material.shapeMatching = {kShapeCompliance, 0.0f};      // undamped
-  const V3 direction = V3(1.0, 0.5, -0.3).normalized();
+  const Vd direction = Vd(1.0, 0.5, -0.3).normalized();
   // Start half a flight behind the origin so that |x| stays small (P7).
   const Vec3 start = (-0.5 * seconds * kSpeed * direction).cast<float>() - Vec3::Constant(0.5f * kSize);
   const auto model = makeSoftBody(makeBoxTets(start, Vec3::Constant(kSize), 3, 3, 3), material, constraints);
@@ -145,13 +140,13 @@ SpinRun simulate(const ConstraintSet& constraints, float linearDamping, double s
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
   for (Index i = 0; i < model->particleCount(); ++i) {
     const Point& x = world.particles().x[world.particleIndex(body, i)];
-    const V3 r = x.pos.cast<double>() - rest.com;
+    const Vd r = x.pos.cast<double>() - rest.com;
     inertia += (1.0 / x.w) * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
   }
-  const V3 axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(inertia).eigenvectors().col(2);
+  const Vd axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(inertia).eigenvectors().col(2);
   for (Index i = 0; i < model->particleCount(); ++i) {
     const Index g = world.particleIndex(body, i);
-    const V3 r = world.particles().x[g].pos.cast<double>() - rest.com;
+    const Vd r = world.particles().x[g].pos.cast<double>() - rest.com;
     world.particles().v[g] = (kSpeed * direction + kSpin * axis.cross(r)).cast<float>();
   }
 

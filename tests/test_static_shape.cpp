@@ -32,19 +32,14 @@
 #include <string>
 #include <vector>
 
+#include "test_support.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/world.h"
 
 namespace vrd {
 namespace {
 
-// Records a measured value in the test report (--gtest_output=xml).
-void record(const std::string& key, double value) {
-  std::ostringstream s;
-  s.precision(6);
-  s << value;
-  ::testing::Test::RecordProperty(key, s.str());
-}
+using testing::record;
 
 constexpr float kSize = 0.1f, kE = 1e4f, kRho = 1000.0f, kG = 9.81f;
 
