@@ -125,21 +125,66 @@ void volume(const VolumeConstraint* c, std::size_t begin, std::size_t end, float
   }
 }
 
-// Strain weights a_k (strainWeights) of one tet or of kLanes tets.
+// Strain weights a_k (strainWeights) of one tet or of kLanes tets. For lanes: column i of each
+// tet's D_rest^-1 is contiguous (Eigen is column-major) and holds (a_1[i], a_2[i], a_3[i]), so one
+// load per tet and a transpose give a_1[i], a_2[i] and a_3[i] for all four. The fourth float read
+// belongs to the next column or to the constraint's compliance and is discarded.
 template <typename T>
 void strainWeightsOf(const StrainConstraint* c, VecOf<T> (&a)[4]) {
   if constexpr (std::is_same_v<T, Lane4>) {
-    for (int k = 0; k < 3; ++k) {
-      auto lane = [&](int col) {
-        return Lane4{c[0].invRestShape(k, col), c[1].invRestShape(k, col), c[2].invRestShape(k, col),
-                     c[3].invRestShape(k, col)};
-      };
-      a[k + 1] = {lane(0), lane(1), lane(2)};
+    Lane4 column[3][3];  // column[i][k] = a_{k+1}[i]
+    for (int i = 0; i < 3; ++i) {
+      __m128 r0 = _mm_loadu_ps(c[0].invRestShape.data() + 3 * i), r1 = _mm_loadu_ps(c[1].invRestShape.data() + 3 * i);
+      __m128 r2 = _mm_loadu_ps(c[2].invRestShape.data() + 3 * i), r3 = _mm_loadu_ps(c[3].invRestShape.data() + 3 * i);
+      _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+      column[i][0] = r0, column[i][1] = r1, column[i][2] = r2;
     }
+    for (int k = 0; k < 3; ++k) a[k + 1] = {column[0][k], column[1][k], column[2][k]};
     a[0] = -(a[1] + a[2] + a[3]);
   } else {
     const auto w = strainWeights(c[0].invRestShape);
     for (int k = 0; k < 4; ++k) a[k] = w[k];
+  }
+}
+
+// The six strain multipliers of one tet, or of kLanes consecutive tets as lanes: the tets' 24
+// floats are contiguous, so components 0-3 and 2-5 of each tet load as one vector each and two
+// transposes give all six lanes.
+template <typename T>
+StrainLambdaT<T> loadStrainLambda(const StrainLambda* lambda) {
+  if constexpr (std::is_same_v<T, Lane4>) {
+    static_assert(sizeof(StrainLambda) == 6 * sizeof(float));
+    const float* f = lambda->data();
+    __m128 a0 = _mm_loadu_ps(f), a1 = _mm_loadu_ps(f + 6), a2 = _mm_loadu_ps(f + 12), a3 = _mm_loadu_ps(f + 18);
+    __m128 b0 = _mm_loadu_ps(f + 2), b1 = _mm_loadu_ps(f + 8), b2 = _mm_loadu_ps(f + 14), b3 = _mm_loadu_ps(f + 20);
+    _MM_TRANSPOSE4_PS(a0, a1, a2, a3);
+    _MM_TRANSPOSE4_PS(b0, b1, b2, b3);
+    return {a0, a1, a2, a3, b2, b3};
+  } else {
+    return *lambda;
+  }
+}
+
+template <typename T>
+void addStrainLambda(StrainLambda* lambda, const StrainLambdaT<T>& delta) {
+  if constexpr (std::is_same_v<T, Lane4>) {
+    const StrainLambdaT<Lane4> sum = [&] {
+      StrainLambdaT<Lane4> s = loadStrainLambda<Lane4>(lambda);
+      for (int c = 0; c < kStrainComponents; ++c) s[c] += delta[c];
+      return s;
+    }();
+    __m128 a0 = sum[0], a1 = sum[1], a2 = sum[2], a3 = sum[3], b0 = sum[4], b1 = sum[5], b2 = _mm_setzero_ps(),
+           b3 = _mm_setzero_ps();
+    _MM_TRANSPOSE4_PS(a0, a1, a2, a3);  // a_l = components 0-3 of tet l
+    _MM_TRANSPOSE4_PS(b0, b1, b2, b3);  // b_l = components 4, 5 of tet l (and two zeros)
+    const __m128 low[kLanes] = {a0, a1, a2, a3}, high[kLanes] = {b0, b1, b2, b3};
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      float* f = lambda[l].data();
+      _mm_storeu_ps(f, low[l]);
+      _mm_storel_pi(reinterpret_cast<__m64*>(f + 4), high[l]);
+    }
+  } else {
+    for (int c = 0; c < kStrainComponents; ++c) (*lambda)[c] += delta[c];
   }
 }
 
@@ -154,19 +199,8 @@ void strain(const StrainConstraint* c, std::size_t begin, std::size_t end, Strai
                                                     splat<T>(damping.strainStretch), r.invH);
     const auto shear = XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &StrainConstraint::shearCompliance),
                                                   splat<T>(damping.strainShear), r.invH);
-    StrainLambdaT<T> l;  // lambda[i + lane][component] -> l[component][lane]
-    for (int comp = 0; comp < kStrainComponents; ++comp)
-      if constexpr (std::is_same_v<T, Lane4>)
-        l[comp] = Lane4{lambda[i][comp], lambda[i + 1][comp], lambda[i + 2][comp], lambda[i + 3][comp]};
-      else
-        l[comp] = lambda[i][comp];
-    const auto out = solveStrain(g.x, g.w, a, l, stretch, shear, g.displacement());
-    for (std::size_t lane = 0; lane < kWidth<T>; ++lane)
-      for (int comp = 0; comp < kStrainComponents; ++comp)
-        if constexpr (std::is_same_v<T, Lane4>)
-          lambda[i + lane][comp] += out.dLambda[comp][lane];
-        else
-          lambda[i][comp] += out.dLambda[comp];
+    const auto out = solveStrain(g.x, g.w, a, loadStrainLambda<T>(lambda + i), stretch, shear, g.displacement());
+    addStrainLambda<T>(lambda + i, out.dLambda);
     g.scatter(out.dp, r.pred);
   }
 }
