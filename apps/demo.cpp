@@ -17,9 +17,9 @@ constexpr float kFingerRadius = 0.02f;  // a fingertip pad: it spans several sur
 constexpr float kPokeStart = 1.5f, kPokeDown = 1.0f, kPokeHold = 0.5f;  // s
 constexpr float kPokeDepth = 0.03f;                                     // 3 cm into the top face
 
-Material demoMaterial(bool paper) {
-  Material m;  // the paper's compliance 0.3 / damping 0.03 by default
-  if (!paper) m.elastic = ElasticModuli{5e3f, 0.45f, 1000.0f, 0.002f};  // gelatine-like jelly, 1 kg
+Material jelly() {
+  Material m;
+  m.elastic = ElasticModuli{5e3f, 0.45f, 1000.0f, 0.002f};  // gelatine-like: E = 5 kPa, a 1 kg cube
   return m;
 }
 
@@ -39,7 +39,7 @@ int runDemo(const DemoOptions& o) {
   settings.iterations = o.iterations;
   World world(settings);
   const TetMesh mesh = makeBoxTetsNear(Vec3(-kSize / 2, 0.0f, -kSize / 2), Vec3::Constant(kSize), o.tets);
-  const auto model = makeSoftBody(mesh, demoMaterial(o.paperMaterial), ConstraintSet::paper());
+  const auto model = makeSoftBody(mesh, jelly(), ConstraintSet::paper());
   const BodyId body = world.addBody(model, Vec3(0.0f, kDrop, 0.0f));
   world.addCollider(Collider::plane(Vec3::UnitY()));
   const float top = kSize + kFingerRadius;
@@ -53,10 +53,8 @@ int runDemo(const DemoOptions& o) {
       kSize * 100, model->particleCount(), model->tets.size(), mass, kDrop * 100, kPokeDepth * 100,
       kFingerRadius * 1000, kPokeStart);
   fmt::print(
-      "Material: {}. Solver: dt = 1/{:.0f} s, {} substep(s) x {} iteration(s); constraints: {} volume, "
-      "{} strain (x6), shape matching.\n\n",
-      o.paperMaterial ? "paper compliance 0.3, damping 0.03, 1 kg per particle"
-                      : "E = 5 kPa, nu = 0.45, rho = 1000 kg/m^3",
+      "Material: E = 5 kPa, nu = 0.45, rho = 1000 kg/m^3. Solver: dt = 1/{:.0f} s, {} substep(s) x {} "
+      "iteration(s); constraints: {} volume, {} strain (x6), shape matching.\n\n",
       1.0f / settings.timeStep, o.substeps, o.iterations, model->volume.size(), model->strain.size());
   fmt::print("{:>6} {:>9} {:>9} {:>9} {:>10} {:>9} {:>10}\n", "t (s)", "top (cm)", "base (cm)", "vol. loss",
              "finger (N)", "contacts", "ground (N)");

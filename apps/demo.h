@@ -8,9 +8,8 @@ struct DemoOptions {
   float seconds = 4.0f;
   int substeps = 4;
   int iterations = 5;
-  int tets = 1000;             ///< approximate tet count of the cube
-  bool paperMaterial = false;  ///< the paper's compliance 0.3 / damping 0.03 instead of E, nu, rho
-  float reportEvery = 0.25f;   ///< seconds between timeline rows
+  int tets = 1000;            ///< approximate tet count of the cube
+  float reportEvery = 0.25f;  ///< seconds between timeline rows
 };
 
 /// Runs the demo, printing to stdout; returns the process exit code.

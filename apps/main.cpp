@@ -22,7 +22,6 @@ int main(int argc, char** argv) {
   run->add_option("--tets", demo.tets, "Approximate number of tetrahedra")
       ->check(CLI::Range(6, 2000000))
       ->capture_default_str();
-  run->add_flag("--paper-material", demo.paperMaterial, "Use the paper's compliance/damping instead of E, nu, rho");
   run->add_option("--report-every", demo.reportEvery, "Seconds between timeline rows")
       ->check(CLI::Range(0.001f, 3600.0f))
       ->capture_default_str();
