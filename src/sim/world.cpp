@@ -182,13 +182,15 @@ void World::step() {
     for (Fingertip& f : fingertips_) f.center += share * (f.goal - f.center);
 
     predict(h);
-    detectContacts(h);
+    detectContacts();
     resetMultipliers();
     for (int it = 0; it < settings_.iterations; ++it) solveIteration(h);
     finalise(h);
   }
-  report_.colliderContacts = colliderContacts_.size();
-  report_.fingertipContacts = fingertipContacts_.size();
+  report_.colliderContacts = std::size_t(
+      std::count_if(contactNormalLambda_.begin(), contactNormalLambda_.end(), [](float l) { return l > 0.0f; }));
+  report_.fingertipContacts =
+      std::size_t(std::count_if(fingertipLambda_.begin(), fingertipLambda_.end(), [](float l) { return l > 0.0f; }));
   ++stepCount_;
 }
 
@@ -206,7 +208,7 @@ void World::predict(float h) {
   }
 }
 
-void World::detectContacts(float /*h*/) {
+void World::detectContacts() {
   StageTimer timer(report_.times, Stage::Detect, settings_.timeStages);
   colliderContacts_.clear();
   fingertipContacts_.clear();

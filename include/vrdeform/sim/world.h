@@ -29,8 +29,8 @@ struct SimEvent {
 struct StepReport {
   std::uint64_t step = 0;             ///< index of the step (0-based)
   StageTimes times;                   ///< summed over substeps and iterations
-  std::size_t colliderContacts = 0;   ///< in the last substep
-  std::size_t fingertipContacts = 0;  ///< in the last substep
+  std::size_t colliderContacts = 0;   ///< contacts that pushed (lambda > 0) in the last substep
+  std::size_t fingertipContacts = 0;  ///< fingertip contacts that pushed in the last substep
 };
 
 class World {
@@ -113,7 +113,7 @@ class World {
 
  private:
   void predict(float h);
-  void detectContacts(float h);
+  void detectContacts();
   void resetMultipliers();
   void solveIteration(float h);
   void finalise(float h);
