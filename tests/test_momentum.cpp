@@ -43,7 +43,6 @@
 #include <cmath>
 #include <limits>
 #include <ostream>
-#include <sstream>
 #include <string>
 
 #include "test_support.h"

@@ -22,7 +22,6 @@
 #include <cmath>
 #include <functional>
 #include <numbers>
-#include <sstream>
 #include <string>
 #include <vector>
 
