@@ -9,8 +9,8 @@ namespace vrd {
 /// (Kuhn subdivision along each cell's main diagonal, so neighbouring cells share faces).
 TetMesh makeBoxTets(const Vec3& origin, const Vec3& size, int nx, int ny, int nz);
 
-/// A box of roughly `targetTets` tets (within a few percent) with cells as close to cubes as
-/// the aspect ratio of `size` allows.
+/// A box of roughly `targetTets` tets (cell counts rounded, so coarse boxes may miss by more
+/// than 10%) with cells as close to cubes as the aspect ratio of `size` allows.
 TetMesh makeBoxTetsNear(const Vec3& origin, const Vec3& size, int targetTets);
 
 /// A rectangular cloth in the plane spanned by `uAxis` and `vAxis` from `origin`, nu*nv quads split
