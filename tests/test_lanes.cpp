@@ -30,7 +30,7 @@ TEST(Lanes, OrderIsAPermutationOfIndependentGroups) {
 }
 
 TEST(Lanes, ModelWithDependentBatchIsRejected) {
-  auto model = std::make_shared<BodyModel>(*makeSoftBody(makeBoxTets(Vec3::Zero(), Vec3::Ones(), 2, 2, 2), Material{}));
+  auto model = std::make_shared<BodyModel>(*makeSoftBody(makeBoxTets(Vec3::Zero(), Vec3::Ones(), 4, 4, 4), Material{}));
   ASSERT_GE(model->batchedStrain, 2 * kLanes);
   // Move a tet that shares a particle with lane 0 into lane 1 of the first group.
   auto shares = [&](const StrainConstraint& a, const StrainConstraint& b) {
