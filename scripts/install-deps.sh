@@ -8,6 +8,9 @@ packages=(
   libeigen3-dev       # small fixed-size maths
   libcli11-dev        # command-line parsing
   libfmt-dev          # formatting of reports
+  libassimp-dev       # surface mesh import
+  libpugixml-dev zlib1g-dev   # VTK XML tet meshes
+  tetgen              # optional mesher, run as a separate program (AGPL)
   libgtest-dev libgmock-dev googletest   # unit tests
   libbenchmark-dev    # benchmarks
   clang-format        # code style check

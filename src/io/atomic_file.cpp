@@ -1,0 +1,37 @@
+#include "io/atomic_file.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <system_error>
+
+#include "vrdeform/error.h"
+
+namespace vrd {
+
+AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
+  temp_ = target_;
+  temp_ += fmt::format(".tmp{}", ::getpid());
+  out_.open(temp_, std::ios::binary | std::ios::trunc);
+  if (!out_) throw Error(fmt::format("cannot write {}: cannot create {}", target_.string(), temp_.string()));
+}
+
+AtomicFile::~AtomicFile() {
+  if (committed_) return;
+  out_.close();
+  std::error_code ignored;
+  std::filesystem::remove(temp_, ignored);
+}
+
+void AtomicFile::commit() {
+  out_.flush();
+  const bool ok = static_cast<bool>(out_);
+  out_.close();
+  if (!ok) throw Error(fmt::format("cannot write {}: write failed (disk full?)", target_.string()));
+  std::error_code error;
+  std::filesystem::rename(temp_, target_, error);
+  if (error) throw Error(fmt::format("cannot write {}: {}", target_.string(), error.message()));
+  committed_ = true;
+}
+
+}  // namespace vrd
