@@ -1,0 +1,209 @@
+#include "io/ply_reader.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <bit>
+#include <cctype>
+#include <cmath>
+#include <charconv>
+#include <cstring>
+#include <optional>
+#include <sstream>
+#include <vector>
+
+#include "vrdeform/error.h"
+
+namespace vrd {
+namespace {
+
+enum class Encoding { Ascii, LittleEndian, BigEndian };
+
+struct ScalarType {
+  int bytes = 0;
+  bool isFloat = false, isSigned = false;
+};
+
+std::optional<ScalarType> scalarType(const std::string& name) {
+  if (name == "char" || name == "int8") return ScalarType{1, false, true};
+  if (name == "uchar" || name == "uint8") return ScalarType{1, false, false};
+  if (name == "short" || name == "int16") return ScalarType{2, false, true};
+  if (name == "ushort" || name == "uint16") return ScalarType{2, false, false};
+  if (name == "int" || name == "int32") return ScalarType{4, false, true};
+  if (name == "uint" || name == "uint32") return ScalarType{4, false, false};
+  if (name == "float" || name == "float32") return ScalarType{4, true, true};
+  if (name == "double" || name == "float64") return ScalarType{8, true, true};
+  return std::nullopt;
+}
+
+struct Property {
+  std::string name;
+  ScalarType type;
+  std::optional<ScalarType> listCount;  // set for list properties
+};
+
+struct Element {
+  std::string name;
+  std::size_t count = 0;
+  std::vector<Property> properties;
+};
+
+// Reads scalars one at a time from the data section, in either encoding.
+class DataReader {
+ public:
+  DataReader(const std::string& name, const std::string& bytes, std::size_t pos, Encoding encoding)
+      : name_(name), bytes_(bytes), pos_(pos), encoding_(encoding) {}
+
+  double read(const ScalarType& type) {
+    if (encoding_ == Encoding::Ascii) return readText();
+    if (bytes_.size() - pos_ < std::size_t(type.bytes))
+      throw Error(fmt::format("{}: the file ends in the middle of its data (truncated?)", name_));
+    unsigned char raw[8];
+    std::memcpy(raw, bytes_.data() + pos_, type.bytes);
+    pos_ += type.bytes;
+    if ((encoding_ == Encoding::BigEndian) == (std::endian::native == std::endian::little))
+      for (int k = 0; k < type.bytes / 2; ++k) std::swap(raw[k], raw[type.bytes - 1 - k]);
+    auto as = [&raw]<typename T>(T) {
+      T value;
+      std::memcpy(&value, raw, sizeof value);
+      return static_cast<double>(value);
+    };
+    if (type.isFloat) return type.bytes == 4 ? as(float{}) : as(double{});
+    switch (type.bytes) {
+      case 1: return type.isSigned ? as(std::int8_t{}) : as(std::uint8_t{});
+      case 2: return type.isSigned ? as(std::int16_t{}) : as(std::uint16_t{});
+      default: return type.isSigned ? as(std::int32_t{}) : as(std::uint32_t{});
+    }
+  }
+
+ private:
+  double readText() {
+    while (pos_ < bytes_.size() && std::isspace(static_cast<unsigned char>(bytes_[pos_]))) ++pos_;
+    if (pos_ == bytes_.size()) throw Error(fmt::format("{}: the file ends in the middle of its data (truncated?)", name_));
+    double value = 0;
+    const auto [end, error] = std::from_chars(bytes_.data() + pos_, bytes_.data() + bytes_.size(), value);
+    if (error != std::errc()) {
+      const std::size_t line = 1 + std::count(bytes_.begin(), bytes_.begin() + pos_, '\n');
+      throw Error(fmt::format("{}:{}: expected a number, found '{}'", name_, line, bytes_.substr(pos_, 12)));
+    }
+    pos_ = end - bytes_.data();
+    return value;
+  }
+
+  const std::string& name_;
+  const std::string& bytes_;
+  std::size_t pos_;
+  Encoding encoding_;
+};
+
+}  // namespace
+
+TriMesh readPly(const std::filesystem::path& path, const std::string& bytes) {
+  const std::string name = path.string();
+  const std::size_t headerEnd = bytes.find("end_header");
+  if (bytes.rfind("ply", 0) != 0) throw Error(fmt::format("{}: not a PLY file (it must start with 'ply')", name));
+  if (headerEnd == std::string::npos) throw Error(fmt::format("{}: the PLY header has no end_header (truncated?)", name));
+  std::size_t dataStart = bytes.find('\n', headerEnd);
+  dataStart = dataStart == std::string::npos ? bytes.size() : dataStart + 1;
+
+  std::istringstream header(bytes.substr(0, headerEnd));
+  std::optional<Encoding> encoding;
+  std::vector<Element> elements;
+  std::string line;
+  for (int lineNo = 1; std::getline(header, line); ++lineNo) {
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    auto fail = [&](const std::string& what) { return Error(fmt::format("{}:{}: {}", name, lineNo, what)); };
+    if (keyword == "format") {
+      std::string format, version;
+      words >> format >> version;
+      if (format == "ascii") encoding = Encoding::Ascii;
+      else if (format == "binary_little_endian") encoding = Encoding::LittleEndian;
+      else if (format == "binary_big_endian") encoding = Encoding::BigEndian;
+      else throw fail(fmt::format("unknown PLY format '{}'", format));
+    } else if (keyword == "element") {
+      Element e;
+      long long count = -1;
+      words >> e.name >> count;
+      if (!words || count < 0) throw fail("malformed element line");
+      e.count = static_cast<std::size_t>(count);
+      elements.push_back(e);
+    } else if (keyword == "property") {
+      if (elements.empty()) throw fail("property before any element");
+      std::string type;
+      words >> type;
+      Property p;
+      if (type == "list") {
+        std::string countType, itemType;
+        words >> countType >> itemType >> p.name;
+        p.listCount = scalarType(countType);
+        const auto item = scalarType(itemType);
+        if (!p.listCount || !item || p.listCount->isFloat) throw fail("malformed list property");
+        p.type = *item;
+      } else {
+        const auto scalar = scalarType(type);
+        words >> p.name;
+        if (!scalar) throw fail(fmt::format("unknown property type '{}'", type));
+        p.type = *scalar;
+      }
+      if (!words) throw fail("malformed property line");
+      elements.back().properties.push_back(p);
+    } else if (keyword != "ply" && keyword != "comment" && keyword != "obj_info" && !keyword.empty()) {
+      throw fail(fmt::format("unexpected '{}' in the PLY header", keyword));
+    }
+  }
+  if (!encoding) throw Error(fmt::format("{}: the PLY header has no format line", name));
+
+  // Each value takes at least one byte (binary) or two (a digit and a separator), so a count the
+  // remaining bytes cannot hold is rejected before anything is allocated.
+  const std::size_t available = bytes.size() - dataStart;
+  const std::size_t perValue = *encoding == Encoding::Ascii ? 2 : 1;
+  for (const Element& e : elements)
+    if (!e.properties.empty() && e.count > available / (perValue * e.properties.size()))
+      throw Error(fmt::format("{}: the header declares {} {} elements, more than the file can hold (truncated?)", name,
+                              e.count, e.name));
+
+  TriMesh mesh;
+  DataReader data(name, bytes, dataStart, *encoding);
+  bool haveVertices = false;
+  for (const Element& e : elements) {
+    const bool isVertex = e.name == "vertex", isFace = e.name == "face";
+    int axisOf[16];
+    for (std::size_t p = 0; p < e.properties.size() && p < 16; ++p) {
+      const std::string& n = e.properties[p].name;
+      axisOf[p] = n == "x" ? 0 : n == "y" ? 1 : n == "z" ? 2 : -1;
+    }
+    if (isVertex) {
+      haveVertices = true;
+      mesh.vertices.resize(e.count, Vec3::Zero());
+    }
+    for (std::size_t i = 0; i < e.count; ++i)
+      for (std::size_t p = 0; p < e.properties.size(); ++p) {
+        const Property& prop = e.properties[p];
+        if (!prop.listCount) {
+          const double value = data.read(prop.type);
+          if (isVertex && p < 16 && axisOf[p] >= 0) mesh.vertices[i][axisOf[p]] = static_cast<float>(value);
+          continue;
+        }
+        const double n = data.read(*prop.listCount);
+        if (n < 0 || n > 1000) throw Error(fmt::format("{}: {} {} has a list of {} items", name, e.name, i, n));
+        std::vector<Index> polygon(static_cast<std::size_t>(n));
+        for (Index& v : polygon) {
+          const double value = data.read(prop.type);
+          if (isFace && (value < 0 || value >= double(mesh.vertices.size()) || value != std::floor(value)))
+            throw Error(fmt::format("{}: face {} refers to vertex {}, but there are {} vertices", name, i, value,
+                                    mesh.vertices.size()));
+          v = static_cast<Index>(value);
+        }
+        if (!isFace || (prop.name != "vertex_indices" && prop.name != "vertex_index")) continue;
+        if (!haveVertices) throw Error(fmt::format("{}: faces come before vertices", name));
+        if (polygon.size() < 3) throw Error(fmt::format("{}: face {} has only {} corners", name, i, polygon.size()));
+        for (std::size_t k = 1; k + 1 < polygon.size(); ++k)
+          mesh.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
+      }
+  }
+  return mesh;
+}
+
+}  // namespace vrd

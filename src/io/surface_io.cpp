@@ -1,0 +1,202 @@
+#include "vrdeform/io/surface_io.h"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <fmt/format.h>
+#include <fmt/ostream.h>
+
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <unordered_map>
+
+#include "io/atomic_file.h"
+#include "io/ply_reader.h"
+#include "vrdeform/error.h"
+
+namespace vrd {
+namespace {
+
+struct PositionKey {
+  std::uint32_t x, y, z;
+  bool operator==(const PositionKey&) const = default;
+};
+
+struct PositionHash {
+  std::size_t operator()(const PositionKey& k) const {
+    return (std::size_t{k.x} * 73856093u) ^ (std::size_t{k.y} * 19349663u) ^ (std::size_t{k.z} * 83492791u);
+  }
+};
+
+// +0 and -0 are one position.
+PositionKey keyOf(const Vec3& p) {
+  return {std::bit_cast<std::uint32_t>(p.x() + 0.0f), std::bit_cast<std::uint32_t>(p.y() + 0.0f),
+          std::bit_cast<std::uint32_t>(p.z() + 0.0f)};
+}
+
+std::string lowerExtension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+// Corners at one position become one vertex, numbered in order of first use.
+TriMesh weld(const TriMesh& raw, const std::string& name) {
+  TriMesh mesh;
+  std::unordered_map<PositionKey, Index, PositionHash> indexOf;
+  for (std::size_t t = 0; t < raw.triangles.size(); ++t) {
+    Triangle triangle;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3& p = raw.vertices[raw.triangles[t][k]];
+      if (!isFinite(p))
+        throw Error(fmt::format("{}: face {} has a non-finite vertex ({}, {}, {})", name, t, p.x(), p.y(), p.z()));
+      const auto [it, added] = indexOf.try_emplace(keyOf(p), static_cast<Index>(mesh.vertices.size()));
+      if (added) mesh.vertices.push_back(p);
+      triangle[k] = it->second;
+    }
+    mesh.triangles.push_back(triangle);
+  }
+  if (mesh.triangles.empty()) throw Error(fmt::format("{}: the file holds no triangles", name));
+  return mesh;
+}
+
+TriMesh readWithAssimp(const std::string& name) {
+  Assimp::Importer importer;
+  // Points and lines are sorted out and dropped; node transforms are applied (OBJ and STL have none).
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const aiScene* scene = importer.ReadFile(
+      name, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure);
+  if (!scene) throw Error(fmt::format("{}: cannot read: {}", name, importer.GetErrorString()));
+  TriMesh raw;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh& part = *scene->mMeshes[m];
+    const auto offset = static_cast<Index>(raw.vertices.size());
+    for (unsigned v = 0; v < part.mNumVertices; ++v)
+      raw.vertices.emplace_back(part.mVertices[v].x, part.mVertices[v].y, part.mVertices[v].z);
+    for (unsigned f = 0; f < part.mNumFaces; ++f) {
+      const aiFace& face = part.mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      Triangle t;
+      for (int k = 0; k < 3; ++k) {
+        if (face.mIndices[k] >= part.mNumVertices) throw Error(fmt::format("{}: face {} refers to a missing vertex", name, f));
+        t[k] = offset + face.mIndices[k];
+      }
+      raw.triangles.push_back(t);
+    }
+  }
+  return raw;
+}
+
+}  // namespace
+
+TriMesh readSurface(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  const std::string ext = lowerExtension(path);
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) throw Error(fmt::format("{}: no such file", name));
+  if (std::filesystem::file_size(path, error) == 0) throw Error(fmt::format("{}: the file is empty", name));
+  if (ext == ".ply") {
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(in), {}};
+    if (!in && !in.eof()) throw Error(fmt::format("{}: cannot read the file", name));
+    return weld(readPly(path, bytes), name);
+  }
+  if (ext != ".obj" && ext != ".off" && ext != ".stl")
+    throw Error(fmt::format("{}: unknown surface format '{}' (use .obj, .off, .stl or .ply)", name, ext));
+  return weld(readWithAssimp(name), name);
+}
+
+namespace {
+
+void writeObj(std::ostream& out, const TriMesh& mesh) {
+  fmt::print(out, "# vrdeform surface: {} vertices, {} triangles\n", mesh.vertices.size(), mesh.triangles.size());
+  for (const Vec3& p : mesh.vertices) fmt::print(out, "v {:.9g} {:.9g} {:.9g}\n", p.x(), p.y(), p.z());
+  for (const Triangle& t : mesh.triangles) fmt::print(out, "f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+}
+
+void writeOff(std::ostream& out, const TriMesh& mesh) {
+  fmt::print(out, "OFF\n{} {} 0\n", mesh.vertices.size(), mesh.triangles.size());
+  for (const Vec3& p : mesh.vertices) fmt::print(out, "{:.9g} {:.9g} {:.9g}\n", p.x(), p.y(), p.z());
+  for (const Triangle& t : mesh.triangles) fmt::print(out, "3 {} {} {}\n", t[0], t[1], t[2]);
+}
+
+template <typename T>
+void writeLittleEndian(std::ostream& out, T value) {
+  static_assert(std::endian::native == std::endian::little, "binary writers assume a little-endian host");
+  out.write(reinterpret_cast<const char*>(&value), sizeof value);
+}
+
+Vec3 faceNormal(const TriMesh& mesh, const Triangle& t) {
+  const Vec3& a = mesh.vertices[t[0]];
+  return (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a).normalized();
+}
+
+void writeStl(std::ostream& out, const TriMesh& mesh, bool binary) {
+  if (!binary) {
+    out << "solid vrdeform\n";
+    for (const Triangle& t : mesh.triangles) {
+      const Vec3 n = faceNormal(mesh, t);
+      fmt::print(out, "facet normal {:.9g} {:.9g} {:.9g}\n outer loop\n", n.x(), n.y(), n.z());
+      for (Index v : t) {
+        const Vec3& p = mesh.vertices[v];
+        fmt::print(out, "  vertex {:.9g} {:.9g} {:.9g}\n", p.x(), p.y(), p.z());
+      }
+      out << " endloop\nendfacet\n";
+    }
+    out << "endsolid vrdeform\n";
+    return;
+  }
+  char header[80] = {};
+  std::strncpy(header, "vrdeform binary STL", sizeof header - 1);
+  out.write(header, sizeof header);
+  writeLittleEndian(out, static_cast<std::uint32_t>(mesh.triangles.size()));
+  for (const Triangle& t : mesh.triangles) {
+    const Vec3 n = faceNormal(mesh, t);
+    for (int k = 0; k < 3; ++k) writeLittleEndian(out, n[k]);
+    for (Index v : t)
+      for (int k = 0; k < 3; ++k) writeLittleEndian(out, mesh.vertices[v][k]);
+    writeLittleEndian(out, std::uint16_t{0});
+  }
+}
+
+void writePly(std::ostream& out, const TriMesh& mesh, bool binary) {
+  fmt::print(out,
+             "ply\nformat {} 1.0\ncomment vrdeform surface\nelement vertex {}\nproperty float x\nproperty float y\n"
+             "property float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+             binary ? "binary_little_endian" : "ascii", mesh.vertices.size(), mesh.triangles.size());
+  if (!binary) {
+    for (const Vec3& p : mesh.vertices) fmt::print(out, "{:.9g} {:.9g} {:.9g}\n", p.x(), p.y(), p.z());
+    for (const Triangle& t : mesh.triangles) fmt::print(out, "3 {} {} {}\n", t[0], t[1], t[2]);
+    return;
+  }
+  for (const Vec3& p : mesh.vertices)
+    for (int k = 0; k < 3; ++k) writeLittleEndian(out, p[k]);
+  for (const Triangle& t : mesh.triangles) {
+    writeLittleEndian(out, std::uint8_t{3});
+    for (Index v : t) writeLittleEndian(out, static_cast<std::int32_t>(v));
+  }
+}
+
+}  // namespace
+
+void writeSurface(const std::filesystem::path& path, const TriMesh& mesh, const SurfaceWriteOptions& options) {
+  const std::string ext = lowerExtension(path);
+  if (ext != ".obj" && ext != ".off" && ext != ".stl" && ext != ".ply")
+    throw Error(fmt::format("{}: unknown surface format '{}' (use .obj, .off, .stl or .ply)", path.string(), ext));
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (Index v : mesh.triangles[t])
+      if (v >= mesh.vertices.size())
+        throw Error(
+            fmt::format("{}: triangle {} refers to vertex {} of {}", path.string(), t, v, mesh.vertices.size()));
+  AtomicFile file(path);
+  std::ostream& out = file.stream();
+  if (ext == ".obj") writeObj(out, mesh);
+  if (ext == ".off") writeOff(out, mesh);
+  if (ext == ".stl") writeStl(out, mesh, options.binary);
+  if (ext == ".ply") writePly(out, mesh, options.binary);
+  file.commit();
+}
+
+}  // namespace vrd
