@@ -15,6 +15,7 @@ template <typename S>
 using Mat3T = Eigen::Matrix<S, 3, 3>;
 
 using Vec3 = Vec3T<float>;
+using Vec3d = Vec3T<double>;  ///< mesh processing, reference maths
 using Mat3 = Mat3T<float>;
 using Quat = Eigen::Quaternionf;
 

@@ -12,7 +12,6 @@
 
 namespace vrd {
 
-using Vec3d = Vec3T<double>;
 using Box3d = Eigen::AlignedBox<double, 3>;
 
 class Bvh {

@@ -1,0 +1,51 @@
+#pragma once
+// Surface -> tet mesh, with either mesher, after the surface checks, to a size bound or a tet
+// count. The built-in mesher (isosurface stuffing) needs nothing else; TetGen (AGPL) runs as a
+// separate program, so its licence stays apart from ours and a crash of it cannot take us down.
+
+#include <filesystem>
+#include <string>
+
+#include "vrdeform/mesh/tet_mesh.h"
+
+namespace vrd {
+
+enum class Mesher { Builtin, TetGen };
+
+struct TetrahedraliseOptions {
+  Mesher mesher = Mesher::Builtin;
+  /// Aim for this many tets: the volume bound is searched until the count is within
+  /// `countTolerance` of it. 0: use maxVolume.
+  std::size_t targetTets = 0;
+  double countTolerance = 0.15;
+  /// Largest tet volume (TetGen -a; built-in: the volume of the lattice's tets). 0 with no
+  /// target: none for TetGen, the surface's volume / 1000 for the built-in mesher.
+  double maxVolume = 0;
+  /// TetGen: largest circumradius / shortest edge (-q); 0 for none. Quality refinement adds tets,
+  /// so when even an unbounded volume gives more than the target, the count search relaxes it
+  /// to 2, then to none.
+  double radiusEdge = 1.5;
+  bool preserveVolume = true;            ///< built-in: see StuffingOptions
+  std::string tetgenProgram = "tetgen";  ///< name in PATH, or a path
+  double timeoutSeconds = 300;           ///< per TetGen run
+};
+
+struct Tetrahedralisation {
+  TetMesh mesh;
+  double maxVolume = 0;   ///< the bound of the run that was kept (0: none)
+  double radiusEdge = 0;  ///< TetGen's quality bound of that run (0: none)
+  int runs = 0;           ///< mesher runs the count search took
+};
+
+/// Checks the surface (requireClosedSurface) and tetrahedralises it; every tet comes out
+/// positively oriented. Throws vrd::Error with the check's findings, for a TetGen that is
+/// missing, fails, crashes or times out (with its last output), or for bad options.
+Tetrahedralisation tetrahedralise(const TriMesh& surface, const TetrahedraliseOptions& options = {});
+
+/// One TetGen run ("-pq<radiusEdge>a<maxVolume>zQ", each bound left out when 0) in a scratch
+/// folder; no checks of the input.
+TetMesh runTetGen(const TriMesh& surface, double maxVolume, double radiusEdge, const TetrahedraliseOptions& options);
+
+const char* toString(Mesher mesher);
+
+}  // namespace vrd
