@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <vector>
 
+#include "vrdeform/io/vtu_sequence.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/world.h"
 
@@ -45,6 +48,15 @@ int runDemo(const DemoOptions& o) {
   const float top = kSize + kFingerRadius;
   const FingertipId finger = world.addFingertip(Vec3(0.0f, top + 0.02f, 0.0f), kFingerRadius);
 
+  std::optional<VtuSequence> saved;
+  if (!o.savePath.empty()) {
+    TetMesh placed = mesh;
+    for (Vec3& v : placed.vertices) v.y() += kDrop;
+    saved.emplace(o.savePath, placed);
+  }
+  const int saveEvery = std::max(1, int(std::lround(o.saveEvery / settings.timeStep)));
+  std::vector<Vec3> positions(model->particleCount());
+
   double mass = 0.0;
   for (float w : model->invMass) mass += 1.0 / w;
   fmt::print(
@@ -70,6 +82,11 @@ int runDemo(const DemoOptions& o) {
     for (std::size_t k = 0; k < kStageCount; ++k) sum.ms[k] += world.lastStep().times.ms[k];
     for (const SimEvent& e : world.takeEvents()) fmt::print("  event: {}\n", e.message);
 
+    if (saved && (s % saveEvery == 0 || s == steps)) {
+      for (Index i = 0; i < model->particleCount(); ++i)
+        positions[i] = world.particles().x[world.particleIndex(body, i)].pos;
+      saved->addFrame(t, positions);
+    }
     const float force = world.fingertipForce(finger).norm();
     peakForce = std::max(peakForce, force);
     peakLoss = std::max(peakLoss, float(world.volumeLoss(body)));

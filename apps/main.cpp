@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "demo.h"
+#include "mesh_commands.h"
 #include "vrdeform/error.h"
 
 int main(int argc, char** argv) {
@@ -26,9 +27,17 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.001f, 3600.0f))
       ->capture_default_str();
 
+  run->add_option("--save", demo.savePath, "Save the deforming body for ParaView: a .pvd plus one .vtu per frame");
+  run->add_option("--save-every", demo.saveEvery, "Seconds between saved frames")
+      ->check(CLI::Range(0.001f, 3600.0f))
+      ->capture_default_str();
+
+  const auto runMeshCommand = vrd::addMeshCommands(app);
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (*run) return vrd::runDemo(demo);
+    if (app.got_subcommand("mesh")) return runMeshCommand();
   } catch (const vrd::Error& e) {
     fmt::print(stderr, "vrdeform: {}\n", e.what());
     return 2;

@@ -20,7 +20,7 @@ namespace {
 // run corrects the bound by the ratio it missed by, within the bracket of bounds known to give
 // too many and too few tets (bisected when the ratio step leaves it: TetGen's count can jump).
 template <typename Run>
-Tetrahedralisation searchCount(Run&& run, double initialBound, const TetrahedraliseOptions& options) {
+Tetrahedralisation searchCount(Run&& run, double initialBound, double aim, const TetrahedraliseOptions& options) {
   const double target = static_cast<double>(options.targetTets);
   Tetrahedralisation best;
   double bound = initialBound, bestMiss = HUGE_VAL;
@@ -35,7 +35,7 @@ Tetrahedralisation searchCount(Run&& run, double initialBound, const Tetrahedral
       best.maxVolume = bound;
     }
     best.runs = attempt;
-    if (miss <= options.countTolerance) break;
+    if (miss <= aim) break;
     (count > target ? tooMany : tooFew) = bound;
     const double next = bound * std::clamp(count / target, 0.1, 10.0);
     const bool bracketed = tooMany > 0 && tooFew < HUGE_VAL;
@@ -47,7 +47,9 @@ Tetrahedralisation searchCount(Run&& run, double initialBound, const Tetrahedral
 Tetrahedralisation builtin(const TriMesh& surface, double volume, const TetrahedraliseOptions& options) {
   // A BCC lattice of cube edge h has tets of volume h^3 / 12.
   auto run = [&](double bound) { return stuffIsosurface(surface, {std::cbrt(12 * bound), options.preserveVolume}); };
-  if (options.targetTets > 0) return searchCount(run, volume / double(options.targetTets), options);
+  // Runs are cheap, so aim closer than the tolerance asks.
+  if (options.targetTets > 0)
+    return searchCount(run, volume / double(options.targetTets), options.countTolerance / 3, options);
   Tetrahedralisation r;
   r.maxVolume = options.maxVolume > 0 ? options.maxVolume : volume / 1000;
   r.mesh = run(r.maxVolume);
@@ -79,9 +81,16 @@ Tetrahedralisation tetgen(const TriMesh& surface, double volume, const Tetrahedr
   }
   if (double(floor.mesh.tets.size()) >= target * (1 - options.countTolerance)) return floor;
   auto run = [&](double bound) { return runTetGen(surface, bound, floor.radiusEdge, options); };
-  Tetrahedralisation r = searchCount(run, 3 * volume / target, options);
+  Tetrahedralisation r = searchCount(run, 3 * volume / target, options.countTolerance, options);
   r.radiusEdge = floor.radiusEdge;
   r.runs += runs;
+  // A volume bound also switches on TetGen's default quality bound, so without one the count can
+  // jump past the target: then the unbounded floor may still be the closest.
+  const auto miss = [&](const TetMesh& m) { return std::abs(double(m.tets.size()) - target); };
+  if (miss(floor.mesh) < miss(r.mesh)) {
+    floor.runs = r.runs;
+    return floor;
+  }
   return r;
 }
 

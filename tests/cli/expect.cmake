@@ -1,0 +1,25 @@
+# Runs one command and checks its exit code, its output and the files it left behind.
+#   cmake -DCOMMAND="prog;arg;..." -DEXIT=<code> [-DOUTPUT=<regex>] [-DEXISTS=<path>] [-DABSENT=<path>]
+#         [-DGARBAGE=<path>] -P expect.cmake
+# GARBAGE writes a file of nonsense bytes first, for the command to choke on.
+if(GARBAGE)
+  string(RANDOM LENGTH 700 RANDOM_SEED 5 ALPHABET "!#%&()*+,-./0123456789:;<=>?@ABCDEFGHIJKLMNOPQRSTUVWXYZ[]^_`abcxyz{|}~" junk)
+  file(WRITE "${GARBAGE}" "${junk}")
+endif()
+if(ABSENT)
+  file(REMOVE "${ABSENT}")
+endif()
+execute_process(COMMAND ${COMMAND} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${out}${err}")
+if(NOT code EQUAL EXIT)
+  message(FATAL_ERROR "exit code ${code}, expected ${EXIT}")
+endif()
+if(OUTPUT AND NOT "${out}${err}" MATCHES "${OUTPUT}")
+  message(FATAL_ERROR "output does not match '${OUTPUT}'")
+endif()
+if(EXISTS_FILE AND NOT EXISTS "${EXISTS_FILE}")
+  message(FATAL_ERROR "${EXISTS_FILE} was not written")
+endif()
+if(ABSENT AND EXISTS "${ABSENT}")
+  message(FATAL_ERROR "${ABSENT} exists: a failed command left output behind")
+endif()
