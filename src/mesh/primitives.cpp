@@ -60,4 +60,10 @@ TriMesh makeGridCloth(const Vec3& origin, const Vec3& uAxis, const Vec3& vAxis, 
   return mesh;
 }
 
+Flag makeFlag(const Vec3& poleTop, float width, float height, int nu, int nv) {
+  Flag flag{makeGridCloth(poleTop, Vec3(width, 0, 0), Vec3(0, -height, 0), nu, nv), {}};
+  for (int iv = 0; iv <= nv; ++iv) flag.pinned.push_back(Index(iv * (nu + 1)));
+  return flag;
+}
+
 }  // namespace vrd

@@ -1,6 +1,8 @@
 #pragma once
 // Procedural meshes for tests, benchmarks and demos.
 
+#include <vector>
+
 #include "vrdeform/mesh/tet_mesh.h"
 
 namespace vrd {
@@ -16,5 +18,13 @@ TetMesh makeBoxTetsNear(const Vec3& origin, const Vec3& size, int targetTets);
 /// A rectangular cloth in the plane spanned by `uAxis` and `vAxis` from `origin`, nu*nv quads split
 /// into two triangles each; vertex (iu, iv) has index iv*(nu+1) + iu.
 TriMesh makeGridCloth(const Vec3& origin, const Vec3& uAxis, const Vec3& vAxis, int nu, int nv);
+
+/// The paper's flag: a cloth of nu x nv cells hung on a vertical pole whose top is `poleTop`,
+/// `width` along +x and `height` down -y. `pinned` lists the nv + 1 vertices on the pole.
+struct Flag {
+  TriMesh cloth;
+  std::vector<Index> pinned;
+};
+Flag makeFlag(const Vec3& poleTop, float width, float height, int nu, int nv);
 
 }  // namespace vrd
