@@ -19,12 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool isSurfaceFile(const fs::path& path) {
-  std::string ext = path.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".obj" || ext == ".off" || ext == ".stl" || ext == ".ply";
-}
-
 // The boundary of a tet mesh as a surface of its own (unused vertices dropped).
 TriMesh boundarySurface(const TetMesh& mesh) {
   TriMesh surface;

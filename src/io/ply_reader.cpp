@@ -3,15 +3,15 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <bit>
 #include <cctype>
-#include <cmath>
 #include <charconv>
-#include <cstring>
+#include <cmath>
 #include <optional>
 #include <sstream>
+#include <string_view>
 #include <vector>
 
+#include "io/binary.h"
 #include "vrdeform/error.h"
 
 namespace vrd {
@@ -19,27 +19,23 @@ namespace {
 
 enum class Encoding { Ascii, LittleEndian, BigEndian };
 
-struct ScalarType {
-  int bytes = 0;
-  bool isFloat = false, isSigned = false;
-};
-
-std::optional<ScalarType> scalarType(const std::string& name) {
-  if (name == "char" || name == "int8") return ScalarType{1, false, true};
-  if (name == "uchar" || name == "uint8") return ScalarType{1, false, false};
-  if (name == "short" || name == "int16") return ScalarType{2, false, true};
-  if (name == "ushort" || name == "uint16") return ScalarType{2, false, false};
-  if (name == "int" || name == "int32") return ScalarType{4, false, true};
-  if (name == "uint" || name == "uint32") return ScalarType{4, false, false};
-  if (name == "float" || name == "float32") return ScalarType{4, true, true};
-  if (name == "double" || name == "float64") return ScalarType{8, true, true};
+std::optional<io::Scalar> scalarType(std::string_view name) {
+  static constexpr std::pair<std::string_view, io::Scalar> kNames[] = {
+      {"char", io::Scalar::Int8},      {"int8", io::Scalar::Int8},       {"uchar", io::Scalar::UInt8},
+      {"uint8", io::Scalar::UInt8},    {"short", io::Scalar::Int16},     {"int16", io::Scalar::Int16},
+      {"ushort", io::Scalar::UInt16},  {"uint16", io::Scalar::UInt16},   {"int", io::Scalar::Int32},
+      {"int32", io::Scalar::Int32},    {"uint", io::Scalar::UInt32},     {"uint32", io::Scalar::UInt32},
+      {"float", io::Scalar::Float32},  {"float32", io::Scalar::Float32}, {"double", io::Scalar::Float64},
+      {"float64", io::Scalar::Float64}};
+  for (const auto& [n, s] : kNames)
+    if (n == name) return s;
   return std::nullopt;
 }
 
 struct Property {
   std::string name;
-  ScalarType type;
-  std::optional<ScalarType> listCount;  // set for list properties
+  io::Scalar type;
+  std::optional<io::Scalar> listCount;  // set for list properties
 };
 
 struct Element {
@@ -54,32 +50,20 @@ class DataReader {
   DataReader(const std::string& name, const std::string& bytes, std::size_t pos, Encoding encoding)
       : name_(name), bytes_(bytes), pos_(pos), encoding_(encoding) {}
 
-  double read(const ScalarType& type) {
+  double read(io::Scalar type) {
     if (encoding_ == Encoding::Ascii) return readText();
-    if (bytes_.size() - pos_ < std::size_t(type.bytes))
+    if (bytes_.size() - pos_ < io::sizeOf(type))
       throw Error(fmt::format("{}: the file ends in the middle of its data (truncated?)", name_));
-    unsigned char raw[8];
-    std::memcpy(raw, bytes_.data() + pos_, type.bytes);
-    pos_ += type.bytes;
-    if ((encoding_ == Encoding::BigEndian) == (std::endian::native == std::endian::little))
-      for (int k = 0; k < type.bytes / 2; ++k) std::swap(raw[k], raw[type.bytes - 1 - k]);
-    auto as = [&raw]<typename T>(T) {
-      T value;
-      std::memcpy(&value, raw, sizeof value);
-      return static_cast<double>(value);
-    };
-    if (type.isFloat) return type.bytes == 4 ? as(float{}) : as(double{});
-    switch (type.bytes) {
-      case 1: return type.isSigned ? as(std::int8_t{}) : as(std::uint8_t{});
-      case 2: return type.isSigned ? as(std::int16_t{}) : as(std::uint16_t{});
-      default: return type.isSigned ? as(std::int32_t{}) : as(std::uint32_t{});
-    }
+    const auto* p = reinterpret_cast<const unsigned char*>(bytes_.data() + pos_);
+    pos_ += io::sizeOf(type);
+    return io::loadScalar<double>(p, type, encoding_ == Encoding::BigEndian);
   }
 
  private:
   double readText() {
     while (pos_ < bytes_.size() && std::isspace(static_cast<unsigned char>(bytes_[pos_]))) ++pos_;
-    if (pos_ == bytes_.size()) throw Error(fmt::format("{}: the file ends in the middle of its data (truncated?)", name_));
+    if (pos_ == bytes_.size())
+      throw Error(fmt::format("{}: the file ends in the middle of its data (truncated?)", name_));
     double value = 0;
     const auto [end, error] = std::from_chars(bytes_.data() + pos_, bytes_.data() + bytes_.size(), value);
     if (error != std::errc()) {
@@ -102,7 +86,8 @@ TriMesh readPly(const std::filesystem::path& path, const std::string& bytes) {
   const std::string name = path.string();
   const std::size_t headerEnd = bytes.find("end_header");
   if (bytes.rfind("ply", 0) != 0) throw Error(fmt::format("{}: not a PLY file (it must start with 'ply')", name));
-  if (headerEnd == std::string::npos) throw Error(fmt::format("{}: the PLY header has no end_header (truncated?)", name));
+  if (headerEnd == std::string::npos)
+    throw Error(fmt::format("{}: the PLY header has no end_header (truncated?)", name));
   std::size_t dataStart = bytes.find('\n', headerEnd);
   dataStart = dataStart == std::string::npos ? bytes.size() : dataStart + 1;
 
@@ -118,10 +103,14 @@ TriMesh readPly(const std::filesystem::path& path, const std::string& bytes) {
     if (keyword == "format") {
       std::string format, version;
       words >> format >> version;
-      if (format == "ascii") encoding = Encoding::Ascii;
-      else if (format == "binary_little_endian") encoding = Encoding::LittleEndian;
-      else if (format == "binary_big_endian") encoding = Encoding::BigEndian;
-      else throw fail(fmt::format("unknown PLY format '{}'", format));
+      if (format == "ascii")
+        encoding = Encoding::Ascii;
+      else if (format == "binary_little_endian")
+        encoding = Encoding::LittleEndian;
+      else if (format == "binary_big_endian")
+        encoding = Encoding::BigEndian;
+      else
+        throw fail(fmt::format("unknown PLY format '{}'", format));
     } else if (keyword == "element") {
       Element e;
       long long count = -1;
@@ -139,7 +128,7 @@ TriMesh readPly(const std::filesystem::path& path, const std::string& bytes) {
         words >> countType >> itemType >> p.name;
         p.listCount = scalarType(countType);
         const auto item = scalarType(itemType);
-        if (!p.listCount || !item || p.listCount->isFloat) throw fail("malformed list property");
+        if (!p.listCount || !item || io::isFloat(*p.listCount)) throw fail("malformed list property");
         p.type = *item;
       } else {
         const auto scalar = scalarType(type);

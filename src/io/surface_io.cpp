@@ -13,6 +13,8 @@
 #include <unordered_map>
 
 #include "io/atomic_file.h"
+#include "io/binary.h"
+#include "io/extension.h"
 #include "io/ply_reader.h"
 #include "vrdeform/error.h"
 
@@ -34,12 +36,6 @@ struct PositionHash {
 PositionKey keyOf(const Vec3& p) {
   return {std::bit_cast<std::uint32_t>(p.x() + 0.0f), std::bit_cast<std::uint32_t>(p.y() + 0.0f),
           std::bit_cast<std::uint32_t>(p.z() + 0.0f)};
-}
-
-std::string lowerExtension(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext;
 }
 
 // Corners at one position become one vertex, numbered in order of first use.
@@ -66,8 +62,8 @@ TriMesh readWithAssimp(const std::string& name) {
   Assimp::Importer importer;
   // Points and lines are sorted out and dropped; node transforms are applied (OBJ and STL have none).
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene = importer.ReadFile(
-      name, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure);
+  const aiScene* scene = importer.ReadFile(name, aiProcess_Triangulate | aiProcess_SortByPType |
+                                                     aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure);
   if (!scene) throw Error(fmt::format("{}: cannot read: {}", name, importer.GetErrorString()));
   TriMesh raw;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
@@ -80,7 +76,8 @@ TriMesh readWithAssimp(const std::string& name) {
       if (face.mNumIndices != 3) continue;
       Triangle t;
       for (int k = 0; k < 3; ++k) {
-        if (face.mIndices[k] >= part.mNumVertices) throw Error(fmt::format("{}: face {} refers to a missing vertex", name, f));
+        if (face.mIndices[k] >= part.mNumVertices)
+          throw Error(fmt::format("{}: face {} refers to a missing vertex", name, f));
         t[k] = offset + face.mIndices[k];
       }
       raw.triangles.push_back(t);
@@ -91,9 +88,14 @@ TriMesh readWithAssimp(const std::string& name) {
 
 }  // namespace
 
+bool isSurfaceFile(const std::filesystem::path& path) {
+  const std::string ext = io::lowerExtension(path);
+  return ext == ".obj" || ext == ".off" || ext == ".stl" || ext == ".ply";
+}
+
 TriMesh readSurface(const std::filesystem::path& path) {
   const std::string name = path.string();
-  const std::string ext = lowerExtension(path);
+  const std::string ext = io::lowerExtension(path);
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) throw Error(fmt::format("{}: no such file", name));
   if (std::filesystem::file_size(path, error) == 0) throw Error(fmt::format("{}: the file is empty", name));
@@ -103,7 +105,7 @@ TriMesh readSurface(const std::filesystem::path& path) {
     if (!in && !in.eof()) throw Error(fmt::format("{}: cannot read the file", name));
     return weld(readPly(path, bytes), name);
   }
-  if (ext != ".obj" && ext != ".off" && ext != ".stl")
+  if (!isSurfaceFile(path))
     throw Error(fmt::format("{}: unknown surface format '{}' (use .obj, .off, .stl or .ply)", name, ext));
   return weld(readWithAssimp(name), name);
 }
@@ -120,12 +122,6 @@ void writeOff(std::ostream& out, const TriMesh& mesh) {
   fmt::print(out, "OFF\n{} {} 0\n", mesh.vertices.size(), mesh.triangles.size());
   for (const Vec3& p : mesh.vertices) fmt::print(out, "{:.9g} {:.9g} {:.9g}\n", p.x(), p.y(), p.z());
   for (const Triangle& t : mesh.triangles) fmt::print(out, "3 {} {} {}\n", t[0], t[1], t[2]);
-}
-
-template <typename T>
-void writeLittleEndian(std::ostream& out, T value) {
-  static_assert(std::endian::native == std::endian::little, "binary writers assume a little-endian host");
-  out.write(reinterpret_cast<const char*>(&value), sizeof value);
 }
 
 Vec3 faceNormal(const TriMesh& mesh, const Triangle& t) {
@@ -148,17 +144,17 @@ void writeStl(std::ostream& out, const TriMesh& mesh, bool binary) {
     out << "endsolid vrdeform\n";
     return;
   }
-  char header[80] = {};
-  std::strncpy(header, "vrdeform binary STL", sizeof header - 1);
-  out.write(header, sizeof header);
-  writeLittleEndian(out, static_cast<std::uint32_t>(mesh.triangles.size()));
+  std::string bytes = "vrdeform binary STL";
+  bytes.resize(80, '\0');
+  io::storeLittle(bytes, static_cast<std::uint32_t>(mesh.triangles.size()));
   for (const Triangle& t : mesh.triangles) {
     const Vec3 n = faceNormal(mesh, t);
-    for (int k = 0; k < 3; ++k) writeLittleEndian(out, n[k]);
+    for (int k = 0; k < 3; ++k) io::storeLittle(bytes, n[k]);
     for (Index v : t)
-      for (int k = 0; k < 3; ++k) writeLittleEndian(out, mesh.vertices[v][k]);
-    writeLittleEndian(out, std::uint16_t{0});
+      for (int k = 0; k < 3; ++k) io::storeLittle(bytes, mesh.vertices[v][k]);
+    bytes += std::string(2, '\0');  // attribute byte count
   }
+  out << bytes;
 }
 
 void writePly(std::ostream& out, const TriMesh& mesh, bool binary) {
@@ -171,19 +167,21 @@ void writePly(std::ostream& out, const TriMesh& mesh, bool binary) {
     for (const Triangle& t : mesh.triangles) fmt::print(out, "3 {} {} {}\n", t[0], t[1], t[2]);
     return;
   }
+  std::string bytes;
   for (const Vec3& p : mesh.vertices)
-    for (int k = 0; k < 3; ++k) writeLittleEndian(out, p[k]);
+    for (int k = 0; k < 3; ++k) io::storeLittle(bytes, p[k]);
   for (const Triangle& t : mesh.triangles) {
-    writeLittleEndian(out, std::uint8_t{3});
-    for (Index v : t) writeLittleEndian(out, static_cast<std::int32_t>(v));
+    io::storeLittle(bytes, std::uint8_t{3});
+    for (Index v : t) io::storeLittle(bytes, static_cast<std::uint32_t>(v));
   }
+  out << bytes;
 }
 
 }  // namespace
 
 void writeSurface(const std::filesystem::path& path, const TriMesh& mesh, const SurfaceWriteOptions& options) {
-  const std::string ext = lowerExtension(path);
-  if (ext != ".obj" && ext != ".off" && ext != ".stl" && ext != ".ply")
+  const std::string ext = io::lowerExtension(path);
+  if (!isSurfaceFile(path))
     throw Error(fmt::format("{}: unknown surface format '{}' (use .obj, .off, .stl or .ply)", path.string(), ext));
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
     for (Index v : mesh.triangles[t])

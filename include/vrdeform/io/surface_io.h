@@ -7,6 +7,9 @@
 
 namespace vrd {
 
+/// Whether the extension names a surface format (.obj, .off, .stl, .ply, any case).
+bool isSurfaceFile(const std::filesystem::path& path);
+
 /// Reads a surface through Assimp; the format comes from the file's content and extension.
 /// Polygons are triangulated, and corners at identical positions become one vertex (STL stores
 /// none shared; OBJ seams split them), numbered in order of first use by a face; vertices no face

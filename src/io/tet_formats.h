@@ -1,0 +1,42 @@
+#pragma once
+// The readers and writers behind readTetMesh/writeTetMesh, one file per format. A reader gets the
+// file's bytes and its name for messages; indices it returns are checked to be in range.
+
+#include <filesystem>
+#include <ostream>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vrdeform/io/tet_io.h"
+
+namespace vrd::io {
+
+TetMesh readTetGen(const std::filesystem::path& nodePath, std::vector<Triangle>* faces);
+void writeTetGen(const std::filesystem::path& anyPath, const TetMesh& mesh);
+
+TetMesh readMedit(std::string_view text, const std::string& name, std::vector<Triangle>* faces);
+void writeMedit(std::ostream& out, const TetMesh& mesh);
+
+TetMesh readGmsh(std::string_view text, const std::string& name, std::vector<Triangle>* faces);
+void writeGmsh(std::ostream& out, const TetMesh& mesh, GmshVersion version);
+
+TetMesh readVtkLegacy(std::string_view text, const std::string& name, std::vector<Triangle>* faces);
+void writeVtkLegacy(std::ostream& out, const TetMesh& mesh);
+
+TetMesh readVtu(std::string_view text, const std::string& name, std::vector<Triangle>* faces);
+/// A named 3-vector per point, written as <PointData>.
+struct VtuPointArray {
+  std::string_view name;
+  std::span<const Vec3> values;
+};
+void writeVtu(std::ostream& out, std::span<const Vec3> points, std::span<const Tet> tets,
+              std::span<const VtuPointArray> pointData, const TetWriteOptions& options);
+
+/// Checks what every reader promises: tets present, finite coordinates, at most 2^32 - 1 vertices.
+void checkReadMesh(const TetMesh& mesh, const std::string& name);
+/// Checks that the mesh can be written and read back: tets present, indices in range, finite coordinates.
+void checkWritableMesh(const TetMesh& mesh);
+
+}  // namespace vrd::io
