@@ -19,23 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The boundary of a tet mesh as a surface of its own (unused vertices dropped).
-TriMesh boundarySurface(const TetMesh& mesh) {
-  TriMesh surface;
-  std::vector<Index> remap(mesh.vertices.size(), ~Index{0});
-  for (Triangle f : boundaryFaces(mesh)) {
-    for (Index& v : f) {
-      if (remap[v] == ~Index{0}) {
-        remap[v] = static_cast<Index>(surface.vertices.size());
-        surface.vertices.push_back(mesh.vertices[v]);
-      }
-      v = remap[v];
-    }
-    surface.triangles.push_back(f);
-  }
-  return surface;
-}
-
 struct CheckArgs {
   std::string input;
   bool open = false;

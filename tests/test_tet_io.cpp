@@ -794,5 +794,21 @@ TEST(Boundary, BoxBoundaryIsClosedDeterministicAndSkipsSharedFaces) {
   EXPECT_ERROR_MENTIONS(boundaryFaces(bad), "tet 1 refers to vertex 5");
 }
 
+TEST(Boundary, SurfaceKeepsOnlyBoundaryVerticesAndMapsThemBack) {
+  // A 3x3x3 box has one interior vertex row per axis: (4^3 - 2^3) = 56 on the boundary.
+  const TetMesh box = makeBoxTets(Vec3::Zero(), Vec3::Ones(), 3, 3, 3);
+  std::vector<Index> tetVertex;
+  const TriMesh surface = boundarySurface(box, &tetVertex);
+  EXPECT_EQ(surface.vertices.size(), 56u);
+  ASSERT_EQ(tetVertex.size(), surface.vertices.size());
+  const std::vector<Triangle> faces = boundaryFaces(box);
+  ASSERT_EQ(surface.triangles.size(), faces.size());
+  for (std::size_t f = 0; f < faces.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(tetVertex[surface.triangles[f][k]], faces[f][k]);
+      EXPECT_EQ(surface.vertices[surface.triangles[f][k]], box.vertices[faces[f][k]]);
+    }
+}
+
 }  // namespace
 }  // namespace vrd

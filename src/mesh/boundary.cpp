@@ -56,4 +56,22 @@ std::vector<Triangle> boundaryFaces(const TetMesh& mesh) {
   return faces;
 }
 
+TriMesh boundarySurface(const TetMesh& mesh, std::vector<Index>* tetVertex) {
+  TriMesh surface;
+  std::vector<Index> remap(mesh.vertices.size(), ~Index{0});
+  if (tetVertex) tetVertex->clear();
+  for (Triangle f : boundaryFaces(mesh)) {
+    for (Index& v : f) {
+      if (remap[v] == ~Index{0}) {
+        remap[v] = static_cast<Index>(surface.vertices.size());
+        surface.vertices.push_back(mesh.vertices[v]);
+        if (tetVertex) tetVertex->push_back(v);
+      }
+      v = remap[v];
+    }
+    surface.triangles.push_back(f);
+  }
+  return surface;
+}
+
 }  // namespace vrd

@@ -14,4 +14,8 @@ namespace vrd {
 /// Throws vrd::Error for an index out of range.
 std::vector<Triangle> boundaryFaces(const TetMesh& mesh);
 
+/// The boundary as a surface of its own: boundaryFaces() with only the vertices they use, numbered
+/// in order of first use. `tetVertex` (optional) receives, per surface vertex, its tet-mesh vertex.
+TriMesh boundarySurface(const TetMesh& mesh, std::vector<Index>* tetVertex = nullptr);
+
 }  // namespace vrd
