@@ -20,7 +20,6 @@
 namespace vrd {
 namespace {
 
-using Vec3d = Vec3T<double>;
 using Mat3d = Mat3T<double>;
 
 // Latitude-longitude sphere: two poles and rings-1 circles of `segments` vertices, outward triangles.

@@ -18,8 +18,9 @@ const fs::path kMeshes = fs::path(VRDEFORM_SHARED_DIR) / "data" / "meshes";
 class SurfaceIo : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("vrd_surface_io_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                                        "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = fs::temp_directory_path() /
+           ("vrd_surface_io_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -88,7 +89,9 @@ TEST_F(SurfaceIo, LargeGridRoundTripsThroughEveryFormat) {
 TEST_F(SurfaceIo, QuadsAreTriangulatedAndSeamsWelded) {
   // A cube of quads whose OBJ corners carry texture coordinates, so positions repeat with different attributes.
   std::string obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nvt 0 0\nvt 1 0\nvt 1 1\n";
-  obj += "f 1/1 4/2 3/3 2/1\nf 5/1 6/2 7/3 8/1\nf 1/2 2/3 6/1 5/2\nf 2/1 3/2 7/3 6/1\nf 3/3 4/1 8/2 7/2\nf 4/1 1/3 5/2 8/3\n";
+  obj +=
+      "f 1/1 4/2 3/3 2/1\nf 5/1 6/2 7/3 8/1\nf 1/2 2/3 6/1 5/2\nf 2/1 3/2 7/3 6/1\nf 3/3 4/1 8/2 7/2\nf 4/1 1/3 5/2 "
+      "8/3\n";
   const TriMesh cube = readSurface(writeBytes("cube.obj", obj));
   EXPECT_EQ(cube.vertices.size(), 8u);
   EXPECT_EQ(cube.triangles.size(), 12u);
@@ -96,10 +99,17 @@ TEST_F(SurfaceIo, QuadsAreTriangulatedAndSeamsWelded) {
 
 TEST_F(SurfaceIo, EverySharedMeshLoadsWithItsDocumentedCounts) {
   const std::pair<const char*, std::pair<std::size_t, std::size_t>> expected[] = {
-      {"bear.obj", {13826, 27648}},          {"bear_coarse.obj", {451, 898}}, {"bunny.obj", {1839, 3674}},
-      {"bunny_coarse.obj", {352, 700}},      {"flag_plane.obj", {841, 1600}}, {"jelly_blobby.obj", {2027, 4050}},
-      {"jelly_blobby_coarse.obj", {296, 588}}, {"liver.obj", {2557, 5110}},   {"liver_coarse.obj", {343, 682}},
-      {"sphere.obj", {812, 1620}},           {"sphere_coarse.obj", {162, 320}}};
+      {"bear.obj", {13826, 27648}},
+      {"bear_coarse.obj", {451, 898}},
+      {"bunny.obj", {1839, 3674}},
+      {"bunny_coarse.obj", {352, 700}},
+      {"flag_plane.obj", {841, 1600}},
+      {"jelly_blobby.obj", {2027, 4050}},
+      {"jelly_blobby_coarse.obj", {296, 588}},
+      {"liver.obj", {2557, 5110}},
+      {"liver_coarse.obj", {343, 682}},
+      {"sphere.obj", {812, 1620}},
+      {"sphere_coarse.obj", {162, 320}}};
   for (const auto& [name, counts] : expected) {
     const TriMesh mesh = readSurface(kMeshes / name);
     EXPECT_EQ(mesh.vertices.size(), counts.first) << name;
