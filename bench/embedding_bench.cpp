@@ -23,31 +23,6 @@
 namespace vrd {
 namespace {
 
-// Latitude-longitude sphere: two poles and rings-1 circles of `segments` vertices.
-TriMesh uvSphere(float radius, int rings, int segments) {
-  TriMesh m;
-  m.vertices.push_back(Vec3(0, 0, radius));
-  for (int i = 1; i < rings; ++i)
-    for (int j = 0; j < segments; ++j) {
-      const double theta = std::numbers::pi * i / rings, phi = 2 * std::numbers::pi * j / segments;
-      m.vertices.push_back(
-          (radius * Vec3T<double>(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)))
-              .cast<float>());
-    }
-  const Index south = static_cast<Index>(m.vertices.size());
-  m.vertices.push_back(Vec3(0, 0, -radius));
-  auto ring = [&](int i, int j) { return static_cast<Index>(1 + (i - 1) * segments + j % segments); };
-  for (int j = 0; j < segments; ++j) {
-    m.triangles.push_back({0, ring(1, j), ring(1, j + 1)});
-    for (int i = 1; i + 1 < rings; ++i) {
-      m.triangles.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
-      m.triangles.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
-    }
-    m.triangles.push_back({ring(rings - 1, j), south, ring(rings - 1, j + 1)});
-  }
-  return m;
-}
-
 TriMesh shuffledVertices(const TriMesh& mesh) {
   std::vector<Index> newIndex(mesh.vertices.size());
   std::iota(newIndex.begin(), newIndex.end(), Index{0});
@@ -66,7 +41,7 @@ struct Scene {
   std::vector<std::vector<Vec3>> frames;  // deformed tet vertices, cycled
 
   explicit Scene(bool shuffled) {
-    const TriMesh sphere = uvSphere(1.0f, 501, 1000);  // 500,002 vertices
+    const TriMesh sphere = makeUvSphere(Vec3::Zero(), 1.0f, 501, 1000);  // 500,002 vertices
     render = shuffled ? shuffledVertices(sphere) : sphere;
     embedding = Embedding::bind(tets, render);
     // Rotate about a tilted axis, squash along y by up to 20% (bulging the others), bend a little.

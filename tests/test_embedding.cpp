@@ -22,32 +22,6 @@ namespace {
 
 using Mat3d = Mat3T<double>;
 
-// Latitude-longitude sphere: two poles and rings-1 circles of `segments` vertices, outward triangles.
-TriMesh uvSphere(const Vec3& centre, float radius, int rings, int segments) {
-  TriMesh m;
-  m.vertices.push_back(centre + Vec3(0, 0, radius));
-  for (int i = 1; i < rings; ++i)
-    for (int j = 0; j < segments; ++j) {
-      const double theta = std::numbers::pi * i / rings, phi = 2 * std::numbers::pi * j / segments;
-      m.vertices.push_back(
-          centre +
-          radius *
-              Vec3d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)).cast<float>());
-    }
-  const Index south = static_cast<Index>(m.vertices.size());
-  m.vertices.push_back(centre - Vec3(0, 0, radius));
-  auto ring = [&](int i, int j) { return static_cast<Index>(1 + (i - 1) * segments + j % segments); };
-  for (int j = 0; j < segments; ++j) {
-    m.triangles.push_back({0, ring(1, j), ring(1, j + 1)});
-    for (int i = 1; i + 1 < rings; ++i) {
-      m.triangles.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
-      m.triangles.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
-    }
-    m.triangles.push_back({ring(rings - 1, j), south, ring(rings - 1, j + 1)});
-  }
-  return m;
-}
-
 // Just enough OBJ for the shared meshes: `v x y z` and `f i j k` (1-based).
 TriMesh readObj(const std::filesystem::path& path) {
   std::ifstream in(path);
@@ -154,7 +128,7 @@ TEST(Embedding, ReproducesRestPositionsAndNormals) {
   const TetMesh tets = makeBoxTets(Vec3(-1.05f, -1.05f, -1.05f), Vec3(2.1f, 2.1f, 2.1f), 4, 4, 4);
   for (float radius : {1.0f, 1.4f}) {  // inside the box, then partly outside
     SCOPED_TRACE(radius);
-    const TriMesh sphere = uvSphere(Vec3(0.05f, -0.02f, 0.03f), radius, 24, 48);
+    const TriMesh sphere = makeUvSphere(Vec3(0.05f, -0.02f, 0.03f), radius, 24, 48);
     const Embedding e = Embedding::bind(tets, sphere);
     EXPECT_EQ(e.vertexCount(), sphere.vertices.size());
     EXPECT_EQ(e.tetVertexCount(), tets.vertices.size());
@@ -172,7 +146,7 @@ TEST(Embedding, ReproducesRestPositionsAndNormals) {
 
 TEST(Embedding, BindingWeightsReproduceRestPositions) {
   const TetMesh tets = makeBoxTets(Vec3(-1, -1, -1), Vec3(2, 2, 2), 3, 3, 3);
-  const TriMesh sphere = uvSphere(Vec3::Zero(), 1.2f, 12, 24);
+  const TriMesh sphere = makeUvSphere(Vec3::Zero(), 1.2f, 12, 24);
   const Embedding e = Embedding::bind(tets, sphere);
   for (std::size_t v = 0; v < sphere.vertices.size(); ++v) {
     const VertexBinding b = e.binding(v);
@@ -190,7 +164,7 @@ TEST(Embedding, BindingWeightsReproduceRestPositions) {
 TEST(Embedding, OutsideVerticesBindToTheNearestTet) {
   // A sphere entirely beside the unit box: its farthest vertex (2.25, 0.5, 0.5) is 1.25 away.
   const TetMesh tets = makeBoxTets(Vec3::Zero(), Vec3::Ones(), 2, 2, 2);
-  const TriMesh sphere = uvSphere(Vec3(2.0f, 0.5f, 0.5f), 0.25f, 8, 16);
+  const TriMesh sphere = makeUvSphere(Vec3(2.0f, 0.5f, 0.5f), 0.25f, 8, 16);
   const Embedding e = Embedding::bind(tets, sphere);
   EXPECT_EQ(e.outsideCount(), sphere.vertices.size());
   EXPECT_NEAR(e.maxOutsideDistance(), 1.25, 1e-6);
@@ -208,7 +182,7 @@ TEST(Embedding, AffineDeformationIsExactInsideAndOutside) {
   const TetMesh tets = makeBoxTets(Vec3(-1.05f, -1.05f, -1.05f), Vec3(2.1f, 2.1f, 2.1f), 4, 4, 4);
   for (float radius : {1.0f, 1.4f}) {
     SCOPED_TRACE(radius);
-    const TriMesh sphere = uvSphere(Vec3(0.05f, -0.02f, 0.03f), radius, 24, 48);
+    const TriMesh sphere = makeUvSphere(Vec3(0.05f, -0.02f, 0.03f), radius, 24, 48);
     Embedding e = Embedding::bind(tets, sphere);
     for (EmbeddingSimd simd : kSimd) {
       e.setSimd(simd);
@@ -219,7 +193,7 @@ TEST(Embedding, AffineDeformationIsExactInsideAndOutside) {
 
 TEST(Embedding, RotationRotatesNormals) {
   const TetMesh tets = makeBoxTets(Vec3(-1, -1, -1), Vec3(2, 2, 2), 3, 3, 3);
-  const TriMesh sphere = uvSphere(Vec3(0.1f, 0, 0), 0.9f, 16, 32);
+  const TriMesh sphere = makeUvSphere(Vec3(0.1f, 0, 0), 0.9f, 16, 32);
   const Embedding e = Embedding::bind(tets, sphere);
   const Mat3d r = Eigen::AngleAxisd(2.0, Vec3d(1, -2, 0.5).normalized()).toRotationMatrix();
   const Output out = update(e, transformed(tets.vertices, r, Vec3d(1, 2, 3)));
@@ -232,7 +206,7 @@ TEST(Embedding, RotationRotatesNormals) {
 
 TEST(Embedding, ReflectionFlipsNormalsLikeTheDeformedTriangles) {
   const TetMesh tets = makeBoxTets(Vec3(-1, -1, -1), Vec3(2, 2, 2), 3, 3, 3);
-  const TriMesh sphere = uvSphere(Vec3(0.1f, 0, 0), 1.1f, 16, 32);
+  const TriMesh sphere = makeUvSphere(Vec3(0.1f, 0, 0), 1.1f, 16, 32);
   const Embedding e = Embedding::bind(tets, sphere);
   const Mat3d mirror = Eigen::Vector3d(-1, 1, 1).asDiagonal();
   const Output out = update(e, transformed(tets.vertices, mirror, Vec3d::Zero()));
@@ -247,7 +221,7 @@ INSTANTIATE_TEST_SUITE_P(EmbeddingSimd, EmbeddingKernels, ::testing::ValuesIn(kS
 
 TEST_P(EmbeddingKernels, CollapsedTetsGiveFiniteOutput) {
   const TetMesh tets = makeBoxTets(Vec3(-1, -1, -1), Vec3(2, 2, 2), 3, 3, 3);
-  const TriMesh sphere = uvSphere(Vec3(0.1f, 0, 0), 1.1f, 16, 32);
+  const TriMesh sphere = makeUvSphere(Vec3(0.1f, 0, 0), 1.1f, 16, 32);
   Embedding e = Embedding::bind(tets, sphere);
   e.setSimd(GetParam());
   const auto rest = exactNormals(sphere, sphere.vertices);
@@ -267,7 +241,7 @@ TEST_P(EmbeddingKernels, CollapsedTetsGiveFiniteOutput) {
     }
   }
   // cof(F) n = 0 exactly (rest normals in the plane z = 0, like the equator's): F n instead.
-  TriMesh disc = uvSphere(Vec3::Zero(), 0.9f, 2, 16);
+  TriMesh disc = makeUvSphere(Vec3::Zero(), 0.9f, 2, 16);
   disc.vertices[0].z() = 0.01f;  // a double cone, its rim on z = 0 with normals in the plane
   disc.vertices.back().z() = -0.01f;
   Embedding coneEmbedding = Embedding::bind(tets, disc);
@@ -294,7 +268,7 @@ TEST_P(EmbeddingKernels, CollapsedTetsGiveFiniteOutput) {
 TEST(Embedding, NearlyFlatTetsKeepAccurateNormals) {
   // Squashed 1e5 times: the tets take the double-precision path, which must agree with the map.
   const TetMesh tets = makeBoxTets(Vec3(-1, -1, -1), Vec3(2, 2, 2), 3, 3, 3);
-  const TriMesh sphere = uvSphere(Vec3(0.1f, 0, 0), 0.9f, 16, 32);
+  const TriMesh sphere = makeUvSphere(Vec3(0.1f, 0, 0), 0.9f, 16, 32);
   const Mat3d a = Eigen::Vector3d(1, 1, 1e-5).asDiagonal();
   const Output out = update(Embedding::bind(tets, sphere), transformed(tets.vertices, a, Vec3d::Zero()));
   expectFinite(out);
@@ -311,7 +285,7 @@ TEST(Embedding, NearlyFlatTetsKeepAccurateNormals) {
 
 TEST_P(EmbeddingKernels, MatchesTheBarycentricFormUnderRandomDeformation) {
   const TetMesh tets = makeBoxTets(Vec3(-1, -1, -1), Vec3(2, 2, 2), 4, 4, 4);
-  const TriMesh sphere = uvSphere(Vec3(0.1f, 0, 0), 1.1f, 20, 160);  // 3,042 vertices: a partial last block
+  const TriMesh sphere = makeUvSphere(Vec3(0.1f, 0, 0), 1.1f, 20, 160);  // 3,042 vertices: a partial last block
   Embedding e = Embedding::bind(tets, sphere);
   e.setSimd(GetParam());
   EXPECT_GT(e.mixedBlockShare(), 0.1);  // both kinds of blocks are exercised
@@ -345,7 +319,7 @@ TEST_P(EmbeddingKernels, MatchesTheBarycentricFormUnderRandomDeformation) {
 
 TEST_P(EmbeddingKernels, UntouchedTetsKeepTheirVertices) {
   const TetMesh tets = makeBoxTets(Vec3(-1, -1, -1), Vec3(2, 2, 2), 4, 4, 4);
-  const TriMesh sphere = uvSphere(Vec3(0.1f, 0, 0), 0.9f, 20, 40);
+  const TriMesh sphere = makeUvSphere(Vec3(0.1f, 0, 0), 0.9f, 20, 40);
   Embedding e = Embedding::bind(tets, sphere);
   e.setSimd(GetParam());
   std::vector<Vec3> x = tets.vertices;
@@ -372,7 +346,7 @@ TEST_P(EmbeddingKernels, UntouchedTetsKeepTheirVertices) {
 
 TEST(Embedding, KernelsAgree) {
   const TetMesh tets = makeBoxTets(Vec3(-1, -1, -1), Vec3(2, 2, 2), 4, 4, 4);
-  const TriMesh sphere = uvSphere(Vec3(0.1f, 0, 0), 1.1f, 20, 41);
+  const TriMesh sphere = makeUvSphere(Vec3(0.1f, 0, 0), 1.1f, 20, 41);
   Embedding e = Embedding::bind(tets, sphere);
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(-0.1f, 0.1f);
@@ -389,7 +363,7 @@ TEST(Embedding, KernelsAgree) {
 
 TEST(Embedding, ReadsSolverParticlesInPlace) {
   const TetMesh tets = makeBoxTets(Vec3(-1, -1, -1), Vec3(2, 2, 2), 3, 3, 3);
-  const TriMesh sphere = uvSphere(Vec3(0.1f, 0, 0), 1.1f, 12, 24);
+  const TriMesh sphere = makeUvSphere(Vec3(0.1f, 0, 0), 1.1f, 12, 24);
   const Embedding e = Embedding::bind(tets, sphere);
   const std::vector<Vec3> x = transformed(tets.vertices, shearStretch(), Vec3d(1, 0, 0));
   std::vector<Point> points;
@@ -450,7 +424,7 @@ TEST(Embedding, BearFollowsAffineMapsInAndAroundItsBox) {
 
 TEST(Embedding, InvalidInputIsAnError) {
   const TetMesh tets = makeBoxTets(Vec3(-1, -1, -1), Vec3(2, 2, 2), 2, 2, 2);
-  const TriMesh sphere = uvSphere(Vec3::Zero(), 0.9f, 8, 16);
+  const TriMesh sphere = makeUvSphere(Vec3::Zero(), 0.9f, 8, 16);
   EXPECT_THROW(Embedding::bind(tets, TriMesh{}), Error);
   TriMesh nan = sphere;
   nan.vertices[5].y() = std::nanf("");
@@ -489,7 +463,7 @@ TEST(Embedding, UnboundEmbeddingIsEmpty) {
 
 TEST(Embedding, LooseRenderVerticesGetZeroNormals) {
   const TetMesh tets = makeBoxTets(Vec3(-1, -1, -1), Vec3(2, 2, 2), 2, 2, 2);
-  TriMesh sphere = uvSphere(Vec3::Zero(), 0.9f, 8, 16);
+  TriMesh sphere = makeUvSphere(Vec3::Zero(), 0.9f, 8, 16);
   sphere.vertices.push_back(Vec3(0.1f, 0.2f, 0.3f));  // in no triangle
   const Embedding e = Embedding::bind(tets, sphere);
   for (const Mat3d& a : {Mat3d(Mat3d::Identity()), Mat3d(Eigen::Vector3d(1, 1, 0).asDiagonal())}) {

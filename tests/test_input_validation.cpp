@@ -4,6 +4,7 @@
 
 #include <limits>
 
+#include "test_support.h"
 #include "vrdeform/error.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/world.h"
@@ -11,17 +12,7 @@
 namespace vrd {
 namespace {
 
-// Runs f, expects vrd::Error, and returns its message.
-template <typename F>
-std::string errorOf(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no vrd::Error thrown";
-  return {};
-}
+using testing::errorOf;
 
 TetMesh unitTet() { return {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}, {{0, 1, 2, 3}}}; }
 

@@ -24,17 +24,7 @@
 namespace vrd {
 namespace {
 
-// Runs f, expects vrd::Error, and returns its message.
-template <typename F>
-std::string errorOf(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no vrd::Error thrown";
-  return {};
-}
+using testing::errorOf;
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 

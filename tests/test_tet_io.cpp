@@ -18,6 +18,7 @@
 #include <sstream>
 #include <string>
 
+#include "test_support.h"
 #include "vrdeform/error.h"
 #include "vrdeform/io/tet_io.h"
 #include "vrdeform/io/vtu_sequence.h"
@@ -74,20 +75,7 @@ std::string readBytes(const fs::path& path) {
   return s.str();
 }
 
-// Runs f, expects vrd::Error, and returns its message.
-template <typename F>
-std::string errorOf(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "not a vrd::Error: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "no vrd::Error thrown";
-  return {};
-}
+using testing::errorOf;
 
 #define EXPECT_ERROR_MENTIONS(statement, text)                                    \
   do {                                                                            \

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "vrdeform/error.h"
 
@@ -58,6 +59,32 @@ TriMesh makeGridCloth(const Vec3& origin, const Vec3& uAxis, const Vec3& vAxis, 
       mesh.triangles.push_back({id(iu, iv), id(iu + 1, iv + 1), id(iu, iv + 1)});
     }
   return mesh;
+}
+
+TriMesh makeUvSphere(const Vec3& centre, float radius, int rings, int segments) {
+  if (rings < 2 || segments < 3) throw Error("makeUvSphere: needs at least 2 rings and 3 segments");
+  TriMesh m;
+  m.vertices.push_back(centre + Vec3(0, 0, radius));
+  for (int i = 1; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const double theta = std::numbers::pi * i / rings, phi = 2 * std::numbers::pi * j / segments;
+      m.vertices.push_back(
+          centre +
+          radius *
+              Vec3d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)).cast<float>());
+    }
+  const Index south = static_cast<Index>(m.vertices.size());
+  m.vertices.push_back(centre - Vec3(0, 0, radius));
+  auto ring = [&](int i, int j) { return static_cast<Index>(1 + (i - 1) * segments + j % segments); };
+  for (int j = 0; j < segments; ++j) {
+    m.triangles.push_back({0, ring(1, j), ring(1, j + 1)});
+    for (int i = 1; i + 1 < rings; ++i) {
+      m.triangles.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
+      m.triangles.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
+    }
+    m.triangles.push_back({ring(rings - 1, j), south, ring(rings - 1, j + 1)});
+  }
+  return m;
 }
 
 Flag makeFlag(const Vec3& poleTop, float width, float height, int nu, int nv) {

@@ -19,6 +19,10 @@ TetMesh makeBoxTetsNear(const Vec3& origin, const Vec3& size, int targetTets);
 /// into two triangles each; vertex (iu, iv) has index iv*(nu+1) + iu.
 TriMesh makeGridCloth(const Vec3& origin, const Vec3& uAxis, const Vec3& vAxis, int nu, int nv);
 
+/// A latitude-longitude sphere surface: two poles and rings - 1 circles of `segments` vertices,
+/// outward-facing triangles (a closed, fine render surface for tests and benchmarks).
+TriMesh makeUvSphere(const Vec3& centre, float radius, int rings, int segments);
+
 /// The paper's flag: a cloth of nu x nv cells hung on a vertical pole whose top is `poleTop`,
 /// `width` along +x and `height` down -y. `pinned` lists the nv + 1 vertices on the pole.
 struct Flag {
