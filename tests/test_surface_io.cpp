@@ -118,6 +118,21 @@ TEST_F(SurfaceIo, EverySharedMeshLoadsWithItsDocumentedCounts) {
   }
 }
 
+TEST_F(SurfaceIo, OriginalOffFilesLoadLikeTheirObjCopies) {
+  // CGAL's originals, one a COFF with vertex colours; the OBJ copies keep their vertex order.
+  const std::pair<const char*, const char*> pairs[] = {{"bear.off", "bear.obj"},
+                                                       {"blobby.off", "jelly_blobby.obj"},
+                                                       {"larger_sphere.off", "sphere.obj"},
+                                                       {"plane.off", "flag_plane.obj"},
+                                                       {"sphere.off", "sphere_coarse.obj"}};
+  for (const auto& [off, obj] : pairs) {
+    const TriMesh a = readSurface(kMeshes / "orig" / "cgal-5.5.1" / off), b = readSurface(kMeshes / obj);
+    ASSERT_EQ(a.vertices.size(), b.vertices.size()) << off;
+    ASSERT_EQ(a.triangles, b.triangles) << off;
+    for (std::size_t v = 0; v < a.vertices.size(); ++v) ASSERT_LT((a.vertices[v] - b.vertices[v]).norm(), 1e-5f) << off;
+  }
+}
+
 TEST_F(SurfaceIo, MissingEmptyAndGarbageFilesAreErrors) {
   auto expectError = [](const fs::path& path, const std::string& says) {
     try {
