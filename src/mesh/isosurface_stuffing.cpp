@@ -79,8 +79,6 @@ struct Stuffer {
   std::vector<Sign> sign;                          // per lattice vertex
   std::unordered_map<std::uint64_t, Index> cutOf;  // edge -> cut point id
 
-  Sign signOf(Index v) const { return v < sign.size() ? sign[v] : kOnSurface; }
-
   void classify() {
     const std::size_t n = lattice.vertexCount();
     position.resize(n);
@@ -166,17 +164,17 @@ struct Stuffer {
       Polygon polygon;
       for (int k = 0; k < 3; ++k) {
         const Index a = tet[face[k]], b = tet[face[(k + 1) % 3]];
-        if (signOf(a) != kOutside) polygon.push_back(a);
-        if (signOf(a) * signOf(b) < 0) polygon.push_back(cut(std::min(a, b), std::max(a, b)));
+        if (sign[a] != kOutside) polygon.push_back(a);
+        if (sign[a] * sign[b] < 0) polygon.push_back(cut(a, b));
       }
       if (polygon.size() >= 3) faces.push_back(polygon);
     }
     // The face on the surface: on-surface vertices and cut points, ordered around their centroid.
     Polygon cap;
     for (int p = 0; p < 4; ++p) {
-      if (signOf(tet[p]) == kOnSurface) cap.push_back(tet[p]);
+      if (sign[tet[p]] == kOnSurface) cap.push_back(tet[p]);
       for (int q = p + 1; q < 4; ++q)
-        if (signOf(tet[p]) * signOf(tet[q]) < 0) cap.push_back(cut(std::min(tet[p], tet[q]), std::max(tet[p], tet[q])));
+        if (sign[tet[p]] * sign[tet[q]] < 0) cap.push_back(cut(tet[p], tet[q]));
     }
     if (cap.size() >= 3) {
       Vec3d centre = Vec3d::Zero();
