@@ -12,7 +12,6 @@
 namespace vrd {
 namespace {
 
-
 constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 
 // Interior angle at edge ab between the faces abc and abd: the angle between c and d seen along
