@@ -5,7 +5,6 @@
 #include <cmath>
 
 #include "vrdeform/error.h"
-#include "vrdeform/mesh/bvh.h"
 #include "vrdeform/mesh/isosurface_stuffing.h"
 #include "vrdeform/mesh/surface_check.h"
 
