@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <assimp/Importer.hpp>
 #include <bit>
-#include <cstring>
 #include <fstream>
 #include <unordered_map>
 
