@@ -1,0 +1,49 @@
+#pragma once
+// The paper's haptic signal (section 5.2, eqs. 40-44, Algorithm 2 lines 24-41): the solver's
+// contact, volume and strain multipliers, normalised, weighted towards the grasp centre, mixed and
+// smoothed into one actuator value in [0, 1]. Pure functions over plain arrays; wiring them to a
+// World and a glove is the hand-interaction layer's job.
+
+#include <span>
+
+#include "vrdeform/math/types.h"
+#include "vrdeform/sim/strain_constraint.h"
+
+namespace vrd {
+
+/// Algorithm 2's parameters. The tau are the multiplier magnitudes that map to full force; they
+/// depend on the material and the time step, so they have no universal default.
+struct HapticSignalSettings {
+  float tauContact = 1.0f;   ///< tau^C (eq. 40)
+  float tauVolume = 1.0f;    ///< tau^V (eq. 41)
+  float tauStrain = 1.0f;    ///< tau^S (eq. 41)
+  float betaContact = 0.5f;  ///< beta_c (eq. 43)
+  float betaVolume = 0.5f;   ///< beta_v (eq. 42); beta_v + beta_s = 1
+  float betaStrain = 0.5f;   ///< beta_s (eq. 42)
+  float epsilon = 1e-3f;     ///< in w_j = 1 / (d_j + epsilon), metres (eq. 42)
+  float alphaT = 0.2f;       ///< smoothing factor per update (eq. 44)
+};
+
+/// Eq. 40 with Algorithm 2's clip (line 36): mean |lambda_i^C| over the contact set, over tau^C.
+/// 0 for an empty set.
+float normalisedContact(std::span<const float> contactLambda, float tauContact);
+
+/// Eqs. 41-42 for one tet: beta_v clip(|lambda^V| / tau^V) + beta_s clip(||lambda^S|| / tau^S).
+float tetSignal(float volumeLambda, const StrainLambda& strainLambda, const HapticSignalSettings& s);
+
+/// F_VS (eq. 43's inverse-distance average): sum_j w_j f_j / sum_j w_j, w_j = 1 / (d_j + epsilon)
+/// with d_j the distance from tet j's centroid to the grasp centre. Spans are per tet and of one
+/// size (volumeLambda or strainLambda may be empty for a body without that constraint).
+float volumeStrainSignal(std::span<const float> volumeLambda, std::span<const StrainLambda> strainLambda,
+                         std::span<const Vec3> centroids, const Vec3& graspCentre, const HapticSignalSettings& s);
+
+/// Eq. 43: F_VS when grasping; clip(beta_c lambda^C + (1 - beta_c) F_VS) when some particle is in
+/// contact; 0 otherwise.
+float rawHapticForce(bool grasping, std::size_t contactCount, float contactSignal, float volumeStrain,
+                     const HapticSignalSettings& s);
+
+/// Eq. 44: (1 - alpha_t) F_out + alpha_t F_raw. A non-finite F_raw counts as 0, so the actuator
+/// never receives NaN; the result stays in [0, 1].
+float smoothHapticForce(float previous, float raw, float alphaT);
+
+}  // namespace vrd
