@@ -36,6 +36,7 @@ struct Property {
   std::string name;
   io::Scalar type;
   std::optional<io::Scalar> listCount;  // set for list properties
+  int axis = -1;                        // 0, 1, 2 for x, y, z
 };
 
 struct Element {
@@ -137,6 +138,7 @@ TriMesh readPly(const std::filesystem::path& path, const std::string& bytes) {
         p.type = *scalar;
       }
       if (!words) throw fail("malformed property line");
+      p.axis = p.name == "x" ? 0 : p.name == "y" ? 1 : p.name == "z" ? 2 : -1;
       elements.back().properties.push_back(p);
     } else if (keyword != "ply" && keyword != "comment" && keyword != "obj_info" && !keyword.empty()) {
       throw fail(fmt::format("unexpected '{}' in the PLY header", keyword));
@@ -158,11 +160,6 @@ TriMesh readPly(const std::filesystem::path& path, const std::string& bytes) {
   bool haveVertices = false;
   for (const Element& e : elements) {
     const bool isVertex = e.name == "vertex", isFace = e.name == "face";
-    int axisOf[16];
-    for (std::size_t p = 0; p < e.properties.size() && p < 16; ++p) {
-      const std::string& n = e.properties[p].name;
-      axisOf[p] = n == "x" ? 0 : n == "y" ? 1 : n == "z" ? 2 : -1;
-    }
     if (isVertex) {
       haveVertices = true;
       mesh.vertices.resize(e.count, Vec3::Zero());
@@ -172,7 +169,7 @@ TriMesh readPly(const std::filesystem::path& path, const std::string& bytes) {
         const Property& prop = e.properties[p];
         if (!prop.listCount) {
           const double value = data.read(prop.type);
-          if (isVertex && p < 16 && axisOf[p] >= 0) mesh.vertices[i][axisOf[p]] = static_cast<float>(value);
+          if (isVertex && prop.axis >= 0) mesh.vertices[i][prop.axis] = static_cast<float>(value);
           continue;
         }
         const double n = data.read(*prop.listCount);

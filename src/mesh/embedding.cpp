@@ -79,23 +79,6 @@ struct RestTets {
   }
 };
 
-template <typename S>
-void accumulateNormals(std::span<const Triangle> triangles, std::span<const Vec3> positions,
-                       std::vector<Vec3T<S>>& sums) {
-  sums.assign(positions.size(), Vec3T<S>::Zero());
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const Triangle& tri = triangles[t];
-    const Index largest = std::max({tri[0], tri[1], tri[2]});
-    if (largest >= positions.size())
-      throw Error(
-          fmt::format("triangle {} refers to vertex {}, but there are only {} vertices", t, largest, positions.size()));
-    const Vec3T<S> a = positions[tri[0]].cast<S>();
-    // |(b - a) x (c - a)| is twice the area: the area weighting comes for free.
-    const Vec3T<S> n = (positions[tri[1]].cast<S>() - a).cross(positions[tri[2]].cast<S>() - a);
-    for (Index v : tri) sums[v] += n;
-  }
-}
-
 /// Unit vector along v, or zero when v is zero (or so small that its length underflows).
 template <typename S>
 Vec3T<S> normalizedOrZero(const Vec3T<S>& v) {
@@ -281,15 +264,6 @@ bool cpuHasAvx2() {
 
 }  // namespace
 
-void computeVertexNormals(std::span<const Triangle> triangles, std::span<const Vec3> positions,
-                          std::span<Vec3> outNormals) {
-  if (outNormals.size() != positions.size())
-    throw Error(fmt::format("{} normals requested for {} positions", outNormals.size(), positions.size()));
-  std::vector<Vec3> sums;
-  accumulateNormals(triangles, positions, sums);
-  for (std::size_t v = 0; v < sums.size(); ++v) outNormals[v] = normalizedOrZero(sums[v]);
-}
-
 Embedding Embedding::bind(const TetMesh& restTets, const TriMesh& render) {
   validateTetMesh(restTets);
   validateTriMesh(render);
@@ -300,8 +274,8 @@ Embedding Embedding::bind(const TetMesh& restTets, const TriMesh& render) {
   std::vector<Box3d> boxes(restTets.tets.size());
   for (std::size_t t = 0; t < boxes.size(); ++t) boxes[t] = elementBox(restTets.vertices, restTets.tets[t]);
   const Bvh bvh(boxes);
-  std::vector<Vec3d> normals;
-  accumulateNormals(render.triangles, render.vertices, normals);
+  std::vector<Vec3> normals(render.vertices.size());
+  computeVertexNormals(render.triangles, render.vertices, normals);
 
   Embedding e;
   const std::size_t n = render.vertices.size();
@@ -337,7 +311,7 @@ Embedding Embedding::bind(const TetMesh& restTets, const TriMesh& render) {
 
     // cof(F) n = cof(Ds) cof(Dm^-1) n, and cof(Dm^-1) n is Dm^T n times det(Dm^-1) > 0.
     const Vec3d b = rest.barycentric(tet, p);
-    const Vec3d m = normalizedOrZero<double>(rest.edges(tet).transpose() * normals[v]);
+    const Vec3d m = normalizedOrZero<double>(rest.edges(tet).transpose() * normals[v].cast<double>());
     Block& block = e.blocks_[v / kBlock];
     for (int k = 0; k < 3; ++k) {
       block.b[k][v % kBlock] = static_cast<float>(b[k]);

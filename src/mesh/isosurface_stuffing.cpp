@@ -11,6 +11,7 @@
 #include "vrdeform/mesh/boundary.h"
 #include "vrdeform/mesh/surface_check.h"
 #include "vrdeform/mesh/surface_query.h"
+#include "vrdeform/mesh/vertex_normals.h"
 
 namespace vrd {
 namespace {
@@ -200,16 +201,12 @@ struct Stuffer {
 // steps, so the tets enclose `targetVolume`; backs off if a tet would flatten.
 void restoreVolume(TetMesh& mesh, double targetVolume) {
   const std::vector<Triangle> boundary = boundaryFaces(mesh);
-  std::vector<Vec3d> normal(mesh.vertices.size(), Vec3d::Zero());
-  for (const Triangle& f : boundary) {
-    const Vec3d a = mesh.vertices[f[0]].cast<double>();
-    const Vec3d n = (mesh.vertices[f[1]].cast<double>() - a).cross(mesh.vertices[f[2]].cast<double>() - a);
-    for (Index v : f) normal[v] += n;
-  }
-  std::vector<Vec3d> rest(mesh.vertices.size());
+  std::vector<Vec3> unitNormal(mesh.vertices.size());  // zero inside
+  computeVertexNormals(boundary, mesh.vertices, unitNormal);
+  std::vector<Vec3d> rest(mesh.vertices.size()), normal(mesh.vertices.size());
   for (std::size_t v = 0; v < rest.size(); ++v) {
     rest[v] = mesh.vertices[v].cast<double>();
-    if (normal[v].squaredNorm() > 0) normal[v].normalize();
+    normal[v] = unitNormal[v].cast<double>();
   }
   // Volume and smallest tet volume with the boundary moved by `offset`.
   auto measure = [&](double offset) {

@@ -111,11 +111,19 @@ TetMesh runTetGen(const TriMesh& surface, double maxVolume, double radiusEdge, c
   if (WEXITSTATUS(status) != 0)
     throw Error(fmt::format("TetGen failed (exit status {}) on this surface ({} {}){}", WEXITSTATUS(status), program,
                             switches, lastLines(log, 5)));
+  TetMesh mesh;
   try {
-    return readTetMesh(scratch.path / "surface.1.node");
+    mesh = readTetMesh(scratch.path / "surface.1.node");
   } catch (const Error& e) {
     throw Error(fmt::format("TetGen's output could not be read: {}{}", e.what(), lastLines(log, 5)));
   }
+  // Debian's TetGen writes positive tets; other builds of the program need not, and the engine
+  // requires them.
+  for (Tet& tet : mesh.tets) {
+    const auto p = [&](int k) -> Vec3d { return mesh.vertices[tet[k]].cast<double>(); };
+    if (signedTetVolume(p(0), p(1), p(2), p(3)) < 0) std::swap(tet[2], tet[3]);
+  }
+  return mesh;
 }
 
 }  // namespace vrd

@@ -19,8 +19,7 @@ namespace {
 // run corrects the bound by the ratio it missed by, within the bracket of bounds known to give
 // too many and too few tets (bisected when the ratio step leaves it: TetGen's count can jump).
 template <typename Run>
-Tetrahedralisation searchCount(Run&& run, double initialBound, double aim, const TetrahedraliseOptions& options) {
-  const double target = static_cast<double>(options.targetTets);
+Tetrahedralisation searchCount(Run&& run, double target, double initialBound, double aim) {
   Tetrahedralisation best;
   double bound = initialBound, bestMiss = HUGE_VAL;
   double tooMany = 0, tooFew = HUGE_VAL;  // bracket: bounds giving more / fewer tets than wanted
@@ -48,7 +47,8 @@ Tetrahedralisation builtin(const TriMesh& surface, double volume, const Tetrahed
   auto run = [&](double bound) { return stuffIsosurface(surface, {std::cbrt(12 * bound), options.preserveVolume}); };
   // Runs are cheap, so aim closer than the tolerance asks.
   if (options.targetTets > 0)
-    return searchCount(run, volume / double(options.targetTets), options.countTolerance / 3, options);
+    return searchCount(run, double(options.targetTets), volume / double(options.targetTets),
+                       options.countTolerance / 3);
   Tetrahedralisation r;
   r.maxVolume = options.maxVolume > 0 ? options.maxVolume : volume / 1000;
   r.mesh = run(r.maxVolume);
@@ -80,7 +80,7 @@ Tetrahedralisation tetgen(const TriMesh& surface, double volume, const Tetrahedr
   }
   if (double(floor.mesh.tets.size()) >= target * (1 - options.countTolerance)) return floor;
   auto run = [&](double bound) { return runTetGen(surface, bound, floor.radiusEdge, options); };
-  Tetrahedralisation r = searchCount(run, 3 * volume / target, options.countTolerance, options);
+  Tetrahedralisation r = searchCount(run, target, 3 * volume / target, options.countTolerance);
   r.radiusEdge = floor.radiusEdge;
   r.runs += runs;
   // A volume bound also switches on TetGen's default quality bound, so without one the count can
@@ -110,11 +110,6 @@ Tetrahedralisation tetrahedralise(const TriMesh& surface, const TetrahedraliseOp
   if (result.mesh.tets.empty())
     throw Error(fmt::format("{} produced no tets (is the size bound {} far above the volume {}?)",
                             toString(options.mesher), result.maxVolume, volume));
-  // TetGen numbers its tets with either orientation; the engine wants positive volumes.
-  for (Tet& t : result.mesh.tets) {
-    const auto p = [&](int k) -> Vec3d { return result.mesh.vertices[t[k]].cast<double>(); };
-    if (signedTetVolume(p(0), p(1), p(2), p(3)) < 0) std::swap(t[2], t[3]);
-  }
   return result;
 }
 

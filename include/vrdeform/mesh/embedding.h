@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "vrdeform/mesh/tet_mesh.h"
+#include "vrdeform/mesh/vertex_normals.h"
 
 namespace vrd {
 
@@ -97,11 +98,5 @@ class Embedding {
   double maxOutsideDistance_ = 0;
   EmbeddingSimd simd_ = EmbeddingSimd::best;
 };
-
-/// Area-weighted unit vertex normals of a triangle surface at `positions` (the exact normals of a
-/// deformed render mesh); zero for a vertex in no triangle or whose triangle normals cancel.
-/// Throws vrd::Error for an out-of-range index or spans of different sizes.
-void computeVertexNormals(std::span<const Triangle> triangles, std::span<const Vec3> positions,
-                          std::span<Vec3> outNormals);
 
 }  // namespace vrd

@@ -43,7 +43,7 @@ struct Tetrahedralisation {
 Tetrahedralisation tetrahedralise(const TriMesh& surface, const TetrahedraliseOptions& options = {});
 
 /// One TetGen run ("-pq<radiusEdge>a<maxVolume>zQ", each bound left out when 0) in a scratch
-/// folder; no checks of the input.
+/// folder, tets oriented positively; no checks of the input.
 TetMesh runTetGen(const TriMesh& surface, double maxVolume, double radiusEdge, const TetrahedraliseOptions& options);
 
 const char* toString(Mesher mesher);
