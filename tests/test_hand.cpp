@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "vrdeform/haptics/hand.h"
+#include "vrdeform/interact/hand.h"
 
 namespace vrd {
 namespace {

@@ -150,6 +150,8 @@ void World::moveFingertip(FingertipId id, const Vec3& goal) {
   fingertips_.at(id).goal = goal;
 }
 
+void World::setFingertipEnabled(FingertipId id, bool enabled) { fingertips_.at(id).enabled = enabled; }
+
 Vec3 World::fingertipForce(FingertipId id) const {
   const float h = substepSize();
   Vec3 force = Vec3::Zero();
@@ -166,6 +168,13 @@ std::size_t World::fingertipContactCount(FingertipId id) const {
   for (std::size_t c = 0; c < fingertipContacts_.size(); ++c)
     count += fingertipContacts_[c].fingertip == id && fingertipLambda_[c] > 0.0f;
   return count;
+}
+
+float World::fingertipLambdaSum(FingertipId id) const {
+  float sum = 0.0f;
+  for (std::size_t c = 0; c < fingertipContacts_.size(); ++c)
+    if (fingertipContacts_[c].fingertip == id) sum += std::abs(fingertipLambda_[c]);
+  return sum;
 }
 
 std::vector<SimEvent> World::takeEvents() { return std::exchange(events_, {}); }
@@ -227,6 +236,7 @@ void World::detectContacts() {
       // Eq. 36: N(r) from the predicted positions, widened by the same margin plus a skin, so that
       // a particle resting on the fingertip is not dropped when its prediction lands just outside.
       for (Index f = 0; f < fingertips_.size(); ++f) {
+        if (!fingertips_[f].enabled) continue;
         const float reach = fingertips_[f].radius * (1.0f + kFingertipSkin) + motion;
         if ((p.pos - fingertips_[f].center).squaredNorm() <= reach * reach) fingertipContacts_.push_back({i, f});
       }

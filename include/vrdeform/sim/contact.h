@@ -51,10 +51,11 @@ inline ContactCorrection solveColliderContact(const Point& p, const Vec3& x0, co
 
 /// A fingertip: a kinematic sphere moved by the user (paper section 5.2).
 struct Fingertip {
-  Vec3 center;       ///< p_finger in the current substep
-  Vec3 goal;         ///< where the centre arrives at the end of the step; substeps move it there linearly
-  float radius;      ///< r (m)
-  float compliance;  ///< alpha of the contact constraints (m/N)
+  Vec3 center;          ///< p_finger in the current substep
+  Vec3 goal;            ///< where the centre arrives at the end of the step; substeps move it there linearly
+  float radius;         ///< r (m)
+  float compliance;     ///< alpha of the contact constraints (m/N)
+  bool enabled = true;  ///< a disabled fingertip makes no contacts (e.g. while it holds a grasp)
 };
 
 /// A particle in the contact set N(r) of a fingertip (eq. 36).

@@ -79,12 +79,16 @@ class World {
   FingertipId addFingertip(const Vec3& center, float radius, float compliance = 0.0f);
   /// Moves a fingertip's centre to `goal` over the next step.
   void moveFingertip(FingertipId id, const Vec3& goal);
+  /// Switches a fingertip's contacts on or off; off, it passes through bodies (N(r) = {}, eq. 36).
+  void setFingertipEnabled(FingertipId id, bool enabled);
   const Fingertip& fingertip(FingertipId id) const { return fingertips_.at(id); }
   std::size_t fingertipCount() const { return fingertips_.size(); }
   /// Total force the fingertip applied to the bodies in the last substep (N).
   Vec3 fingertipForce(FingertipId id) const;
   /// Number of particles the fingertip pushed in the last substep (contacts with lambda > 0).
   std::size_t fingertipContactCount(FingertipId id) const;
+  /// Sum of |lambda^C| over the fingertip's contacts in the last substep: eq. 40's numerator.
+  float fingertipLambdaSum(FingertipId id) const;
 
   const std::vector<ColliderContact>& colliderContacts() const { return colliderContacts_; }
   const std::vector<float>& colliderContactNormalLambda() const { return contactNormalLambda_; }

@@ -1,4 +1,4 @@
-#include "vrdeform/haptics/hand.h"
+#include "vrdeform/interact/hand.h"
 
 #include <algorithm>
 #include <cmath>
