@@ -36,6 +36,14 @@ struct HandPose {
   std::array<float, kFingerCount> closure{};  ///< 0 open .. 1 closed; clamped, NaN reads as open
 };
 
+/// One step of hand input: a wrist pose with finger closures (gloves, scripts), or fingertip
+/// centres given directly (tracked hands, controllers, mouse).
+struct HandFrame {
+  HandPose pose;
+  bool direct = false;                          ///< use `fingertips` as they are instead of the pose
+  std::array<Vec3, kFingerCount> fingertips{};  ///< world fingertip centres when direct
+};
+
 /// The centre of a fingertip sphere in world coordinates.
 Vec3 fingertipPosition(const HandGeometry& hand, const HandPose& pose, Finger finger);
 
