@@ -13,12 +13,11 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 TEST(HapticSignal, ContactIsTheMeanMagnitudeOverTau) {
-  EXPECT_EQ(normalisedContact({}, 1.0f), 0.0f);
-  const std::vector<float> lambdas{1.0f, -3.0f};
-  EXPECT_FLOAT_EQ(normalisedContact(lambdas, 4.0f), 0.5f);  // (1 + 3) / (2 * 4)
-  EXPECT_FLOAT_EQ(normalisedContact(lambdas, 1.0f), 1.0f);  // clipped
-  const std::vector<float> broken{kNaN, 1.0f};
-  EXPECT_EQ(normalisedContact(broken, 1.0f), 0.0f);
+  EXPECT_EQ(normalisedContact(0.0f, 0, 1.0f), 0.0f);
+  EXPECT_EQ(normalisedContact(5.0f, 0, 1.0f), 0.0f);        // empty N(r): no contact term
+  EXPECT_FLOAT_EQ(normalisedContact(4.0f, 2, 4.0f), 0.5f);  // (1 + 3) / (2 * 4)
+  EXPECT_FLOAT_EQ(normalisedContact(4.0f, 2, 1.0f), 1.0f);  // clipped
+  EXPECT_EQ(normalisedContact(kNaN, 2, 1.0f), 0.0f);
 }
 
 TEST(HapticSignal, TetSignalWeighsClippedVolumeAndStrain) {
@@ -35,17 +34,13 @@ TEST(HapticSignal, TetSignalWeighsClippedVolumeAndStrain) {
 }
 
 TEST(HapticSignal, VolumeStrainAverageFavoursTetsNearTheGraspCentre) {
-  HapticSignalSettings s;
-  s.betaVolume = 1.0f;
-  s.betaStrain = 0.0f;
-  s.epsilon = 1e-3f;
   const std::vector<Vec3> centroids{Vec3(0, 0, 0), Vec3(1, 0, 0)};
-  const std::vector<float> volume{1.0f, 0.0f};  // f = 1 at the centre, 0 one metre away
+  const std::vector<float> f{1.0f, 0.0f};  // f = 1 at the centre, 0 one metre away
   // w = 1/(0 + 1e-3) = 1000 and 1/(1 + 1e-3): F_VS = 1000 / (1000 + 0.999).
-  EXPECT_NEAR(volumeStrainSignal(volume, {}, centroids, Vec3::Zero(), s), 1000.0 / (1000.0 + 1.0 / 1.001), 1e-6);
+  EXPECT_NEAR(volumeStrainSignal(centroids, f, Vec3::Zero(), 1e-3f), 1000.0 / (1000.0 + 1.0 / 1.001), 1e-6);
   // Seen from halfway, both weigh the same: the plain mean.
-  EXPECT_NEAR(volumeStrainSignal(volume, {}, centroids, Vec3(0.5f, 0, 0), s), 0.5, 1e-6);
-  EXPECT_EQ(volumeStrainSignal({}, {}, {}, Vec3::Zero(), s), 0.0f);
+  EXPECT_NEAR(volumeStrainSignal(centroids, f, Vec3(0.5f, 0, 0), 1e-3f), 0.5, 1e-6);
+  EXPECT_EQ(volumeStrainSignal({}, {}, Vec3::Zero(), 1e-3f), 0.0f);
 }
 
 TEST(HapticSignal, RawForceFollowsTheThreeCasesOfEq43) {
@@ -69,6 +64,15 @@ TEST(HapticSignal, SmoothingIsAFirstOrderLagThatNeverLeavesTheUnitInterval) {
   EXPECT_LT(out, 1e-6f);
   EXPECT_EQ(smoothHapticForce(0.5f, 7.0f, 1.0f), 1.0f);
   EXPECT_EQ(smoothHapticForce(kNaN, 0.5f, 0.5f), 0.25f);
+}
+
+TEST(HapticSignal, ChangeLimitCapsEachStepButReachesTheTarget) {
+  EXPECT_FLOAT_EQ(limitChange(0.0f, 1.0f, 0.25f), 0.25f);
+  EXPECT_FLOAT_EQ(limitChange(0.5f, 0.0f, 0.25f), 0.25f);
+  EXPECT_FLOAT_EQ(limitChange(0.5f, 0.6f, 0.25f), 0.6f);
+  float out = 0.0f;
+  for (int n = 0; n < 4; ++n) out = limitChange(out, 1.0f, 0.25f);
+  EXPECT_FLOAT_EQ(out, 1.0f);
 }
 
 }  // namespace

@@ -11,11 +11,9 @@ float unitClip(float x) { return x > 0.0f ? std::min(x, 1.0f) : 0.0f; }
 
 }  // namespace
 
-float normalisedContact(std::span<const float> contactLambda, float tauContact) {
-  if (contactLambda.empty()) return 0.0f;
-  double sum = 0.0;
-  for (float l : contactLambda) sum += std::abs(l);
-  return unitClip(float(sum / (double(contactLambda.size()) * tauContact)));
+float normalisedContact(float lambdaSum, std::size_t contactCount, float tauContact) {
+  if (contactCount == 0) return 0.0f;
+  return unitClip(std::abs(lambdaSum) / (float(contactCount) * tauContact));
 }
 
 float tetSignal(float volumeLambda, const StrainLambda& strainLambda, const HapticSignalSettings& s) {
@@ -25,15 +23,12 @@ float tetSignal(float volumeLambda, const StrainLambda& strainLambda, const Hapt
          s.betaStrain * unitClip(std::sqrt(strainSq) / s.tauStrain);
 }
 
-float volumeStrainSignal(std::span<const float> volumeLambda, std::span<const StrainLambda> strainLambda,
-                         std::span<const Vec3> centroids, const Vec3& graspCentre, const HapticSignalSettings& s) {
-  static const StrainLambda kNoStrain{};
+float volumeStrainSignal(std::span<const Vec3> centroids, std::span<const float> tetSignals, const Vec3& graspCentre,
+                         float epsilon) {
   double weighted = 0.0, weights = 0.0;
-  for (std::size_t j = 0; j < centroids.size(); ++j) {
-    const float w = 1.0f / ((centroids[j] - graspCentre).norm() + s.epsilon);
-    const float f = tetSignal(j < volumeLambda.size() ? volumeLambda[j] : 0.0f,
-                              j < strainLambda.size() ? strainLambda[j] : kNoStrain, s);
-    weighted += double(w) * f;
+  for (std::size_t j = 0; j < centroids.size() && j < tetSignals.size(); ++j) {
+    const double w = 1.0 / (double((centroids[j] - graspCentre).norm()) + epsilon);
+    weighted += w * tetSignals[j];
     weights += w;
   }
   return weights > 0.0 ? unitClip(float(weighted / weights)) : 0.0f;
@@ -48,6 +43,10 @@ float rawHapticForce(bool grasping, std::size_t contactCount, float contactSigna
 
 float smoothHapticForce(float previous, float raw, float alphaT) {
   return unitClip((1.0f - alphaT) * unitClip(previous) + alphaT * unitClip(raw));
+}
+
+float limitChange(float previous, float next, float maxStep) {
+  return std::clamp(next, previous - maxStep, previous + maxStep);
 }
 
 }  // namespace vrd

@@ -24,18 +24,17 @@ struct HapticSignalSettings {
   float alphaT = 0.2f;       ///< smoothing factor per update (eq. 44)
 };
 
-/// Eq. 40 with Algorithm 2's clip (line 36): mean |lambda_i^C| over the contact set, over tau^C.
-/// 0 for an empty set.
-float normalisedContact(std::span<const float> contactLambda, float tauContact);
+/// Eq. 40 with Algorithm 2's clip (line 36): sum_i |lambda_i^C| over |N(r)| tau^C. 0 for an
+/// empty contact set.
+float normalisedContact(float lambdaSum, std::size_t contactCount, float tauContact);
 
 /// Eqs. 41-42 for one tet: beta_v clip(|lambda^V| / tau^V) + beta_s clip(||lambda^S|| / tau^S).
 float tetSignal(float volumeLambda, const StrainLambda& strainLambda, const HapticSignalSettings& s);
 
-/// F_VS (eq. 43's inverse-distance average): sum_j w_j f_j / sum_j w_j, w_j = 1 / (d_j + epsilon)
-/// with d_j the distance from tet j's centroid to the grasp centre. Spans are per tet and of one
-/// size (volumeLambda or strainLambda may be empty for a body without that constraint).
-float volumeStrainSignal(std::span<const float> volumeLambda, std::span<const StrainLambda> strainLambda,
-                         std::span<const Vec3> centroids, const Vec3& graspCentre, const HapticSignalSettings& s);
+/// F_VS (eq. 43's inverse-distance average): sum_j w_j f_j / sum_j w_j with w_j = 1 / (d_j +
+/// epsilon), d_j the distance from tet j's centroid to the grasp centre, f_j its tetSignal().
+float volumeStrainSignal(std::span<const Vec3> centroids, std::span<const float> tetSignals, const Vec3& graspCentre,
+                         float epsilon);
 
 /// Eq. 43: F_VS when grasping; clip(beta_c lambda^C + (1 - beta_c) F_VS) when some particle is in
 /// contact; 0 otherwise.
@@ -45,5 +44,9 @@ float rawHapticForce(bool grasping, std::size_t contactCount, float contactSigna
 /// Eq. 44: (1 - alpha_t) F_out + alpha_t F_raw. A non-finite F_raw counts as 0, so the actuator
 /// never receives NaN; the result stays in [0, 1].
 float smoothHapticForce(float previous, float raw, float alphaT);
+
+/// Moves from `previous` towards `next` by at most `maxStep` (beyond the paper: a limit on how
+/// fast the actuator may be driven).
+float limitChange(float previous, float next, float maxStep);
 
 }  // namespace vrd

@@ -20,6 +20,8 @@ enum class Stage : std::uint8_t {
   Contact,        ///< collider contacts with friction
   Fingertip,      ///< fingertip contacts
   Finalise,       ///< velocity update, commit, NaN check (lines 18-21)
+  Interact,       ///< hand input and grasp (Algorithm 2, lines 3-10), measured by a haptic session
+  Force,          ///< haptic force model (Algorithm 2, lines 24-41), measured by a haptic session
   Count
 };
 

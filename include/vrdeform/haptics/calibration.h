@@ -1,0 +1,44 @@
+#pragma once
+// Automatic calibration of the haptic scales tau^C, tau^V, tau^S (eqs. 40-41). The multipliers'
+// magnitudes depend on the material, the mesh and the time step, so instead of tuning them by
+// hand the user's world is poked in a standard way (on a copy) and the tau are set so that this
+// standard poke reaches a chosen level of the signal.
+//
+// Standard poke: a fingertip sphere comes down along gravity onto the body's highest particle and
+// presses `depth` (default: one fingertip radius) below it over `duration`, then holds for half
+// that time. At the end, tau^C is the mean contact multiplier over `contactTarget`, and tau^V,
+// tau^S (in the ratio of their inverse-distance-weighted means around the fingertip) are scaled
+// so that F_VS equals `volumeStrainTarget`.
+
+#include <optional>
+
+#include "vrdeform/haptics/haptic_signal.h"
+#include "vrdeform/sim/world.h"
+
+namespace vrd {
+
+struct CalibrationSettings {
+  float radius = 0.009f;            ///< fingertip radius (m)
+  float depth = 0.0f;               ///< indentation (m); 0 = the radius
+  float duration = 1.0f;            ///< loading time (s)
+  float contactTarget = 1.0f;       ///< normalised contact multiplier at full depth
+  float volumeStrainTarget = 0.8f;  ///< F_VS at full depth
+  std::optional<Vec3> point;        ///< poke this surface point instead of the highest particle
+};
+
+struct HapticCalibration {
+  HapticSignalSettings signal;  ///< the given settings with the three tau replaced
+  Vec3 point;                   ///< where the poke touched
+  Vec3 direction;               ///< unit direction it pressed in
+  float depth = 0.0f;           ///< indentation reached (m)
+  float force = 0.0f;           ///< contact force at full depth (N)
+  std::size_t contacts = 0;     ///< contacts at full depth
+};
+
+/// Pokes a copy of `world` (the original is not touched; its own fingertips are switched off in
+/// the copy). Throws vrd::Error when the poke makes no contact or the body gives way as a whole
+/// (a body needs support, e.g. ground or pins, to be calibrated).
+HapticCalibration calibrateHaptics(const World& world, BodyId body, const HapticSignalSettings& base = {},
+                                   const CalibrationSettings& settings = {});
+
+}  // namespace vrd
