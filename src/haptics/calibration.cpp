@@ -92,6 +92,7 @@ HapticCalibration calibrateHaptics(const World& original, BodyId body, const Hap
   out.force = world.fingertipForce(tip).norm();
   out.contacts = count;
   out.signal.tauContact = world.fingertipLambdaSum(tip) / float(count) / settings.contactTarget;
+  out.signal.tauFingerContact = world.fingertipLambdaSum(tip) / settings.contactTarget;
 
   std::vector<Vec3> centroids;
   const auto [volume, strain] = weightedMultipliers(world, body, world.fingertip(tip).center, base.epsilon, centroids);
@@ -117,7 +118,8 @@ HapticCalibration calibrateHaptics(const World& original, BodyId body, const Hap
     out.signal.tauVolume = s.tauVolume;
     out.signal.tauStrain = s.tauStrain;
   }
-  if (!(out.signal.tauContact > 0.0f && std::isfinite(out.signal.tauContact) && out.signal.tauVolume > 0.0f &&
+  if (!(out.signal.tauContact > 0.0f && std::isfinite(out.signal.tauContact) && out.signal.tauFingerContact > 0.0f &&
+        std::isfinite(out.signal.tauFingerContact) && out.signal.tauVolume > 0.0f &&
         std::isfinite(out.signal.tauVolume) && out.signal.tauStrain > 0.0f && std::isfinite(out.signal.tauStrain)))
     throw Error("calibration: the poke gave non-finite or zero multipliers");
   return out;

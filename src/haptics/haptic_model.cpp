@@ -28,6 +28,7 @@ void validateHapticSettings(const HapticSettings& settings) {
     if (!(v >= 0.0f && v <= 1.0f)) throw Error(fmt::format("haptics: {} must be in [0, 1], got {}", name, v));
   };
   positive(s.tauContact, "tauContact");
+  positive(s.tauFingerContact, "tauFingerContact");
   positive(s.tauVolume, "tauVolume");
   positive(s.tauStrain, "tauStrain");
   unit(s.betaContact, "betaContact");
@@ -94,8 +95,9 @@ const HapticFrame& HapticModel::update(const World& world, const HandRig& rig, c
     handLambda += lambdaSum;
     const bool holding = grasp.pinching(Finger(f));
 
-    // Eq. 43 for this finger alone: its contacts, its position as the grasp centre.
-    out.raw = rawHapticForce(holding, count, normalisedContact(lambdaSum, count, s.tauContact),
+    // Eq. 43 for this finger alone: its contacts (summed, not averaged: one set of size 1), its
+    // position as the grasp centre.
+    out.raw = rawHapticForce(holding, count, normalisedContact(lambdaSum, count > 0 ? 1 : 0, s.tauFingerContact),
                              count > 0 || holding ? inverseDistanceSignal(centre) : 0.0f, s);
     out.force = limitChange(out.force, smoothHapticForce(out.force, out.raw, s.alphaT), maxStep);
     out.contacts = count;

@@ -6,7 +6,8 @@
 //
 // Standard poke: a fingertip sphere comes down along gravity onto the body's highest particle and
 // presses `depth` (default: one fingertip radius) below it over `duration`, then holds for half
-// that time. At the end, tau^C is the mean contact multiplier over `contactTarget`, and tau^V,
+// that time. At the end, tau^C is the mean contact multiplier over `contactTarget` (the finger's
+// summed multipliers over it for tauFingerContact), and tau^V,
 // tau^S (in the ratio of their inverse-distance-weighted means around the fingertip) are scaled
 // so that F_VS equals `volumeStrainTarget`.
 

@@ -14,7 +14,11 @@ namespace vrd {
 /// Algorithm 2's parameters. The tau are the multiplier magnitudes that map to full force; they
 /// depend on the material and the time step, so they have no universal default.
 struct HapticSignalSettings {
-  float tauContact = 1.0f;   ///< tau^C (eq. 40)
+  float tauContact = 1.0f;  ///< tau^C (eq. 40): mean contact multiplier at full force
+  /// Beyond the paper: the summed contact multipliers of one fingertip at full force. A finger's
+  /// own contact term is sum_i |lambda_i^C| / tauFingerContact, which, unlike eq. 40's mean, does
+  /// not drop when one more particle joins the contact set.
+  float tauFingerContact = 1.0f;
   float tauVolume = 1.0f;    ///< tau^V (eq. 41)
   float tauStrain = 1.0f;    ///< tau^S (eq. 41)
   float betaContact = 0.5f;  ///< beta_c (eq. 43)
