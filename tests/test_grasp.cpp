@@ -2,6 +2,9 @@
 // and index, lifted, and let go, in both grasp modes.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "test_support.h"
 #include "vrdeform/haptics/haptic_session.h"
 #include "vrdeform/mesh/primitives.h"
@@ -43,7 +46,7 @@ HandFrame pinch(float gap, float height) {
 }
 
 struct GraspRun {
-  float restHeight, liftedRise, heldFingerError, droppedHeight;
+  float restHeight, liftedRise, heldFingerError, droppedHeight, holdLift, weight;
   bool graspedBeforeLift, graspedWhileLifting, releasedAtEnd;
 };
 
@@ -61,8 +64,11 @@ GraspRun liftAndDrop(GraspMode mode) {
   out.graspedBeforeLift = session.grasp().active();
   const float grasped = block.centroid().y();
   for (int k = 1; k <= 60; ++k) session.step(pinch(closed, height + 0.1f * float(k) / 60));
-  for (int k = 0; k < 60; ++k) session.step(pinch(closed, height + 0.1f));
+  for (int k = 0; k < 120; ++k) session.step(pinch(closed, height + 0.1f));
   out.graspedWhileLifting = session.grasp().active();
+  out.holdLift = 0;
+  for (Finger f : {Finger::Thumb, Finger::Index}) out.holdLift += session.grasp().holdForce(block.world, f).y();
+  out.weight = 500.0f * std::pow(2 * kHalf, 3.0f) * 9.81f;
   out.liftedRise = block.centroid().y() - grasped;
   // The particle nearest each fingertip stays with it.
   out.heldFingerError = 0;
@@ -102,6 +108,62 @@ TEST(Grasp, LocalModeHoldsThePinchedParticlesAndLetsTheRestHang) {
   EXPECT_LT(run.heldFingerError, HandGeometry::average().fingertipRadius * 1.5f);  // and stayed at the fingers
   EXPECT_TRUE(run.releasedAtEnd);
   EXPECT_NEAR(run.droppedHeight, 0.0f, 0.005f);
+}
+
+TEST(Grasp, SqueezingDoesNotFlicker) {
+  // Hysteresis: once held, an aperture that wobbles by less than releaseOpening keeps the grasp.
+  Block block;
+  HapticSessionSettings s;
+  const float r = s.hand.geometry.fingertipRadius;
+  const float open = 2 * (kHalf + r) + 0.02f, closed = 2 * (kHalf + r) - 0.02f;
+  HapticSession session(block.world, s, pinch(open, kHalf));
+  for (int k = 1; k <= 40; ++k) session.step(pinch(open + (closed - open) * float(k) / 40, kHalf));
+  ASSERT_TRUE(session.grasp().active());
+  for (int k = 0; k < 120; ++k) {
+    session.step(pinch(closed + 0.8f * s.grasp.releaseOpening * std::sin(0.3f * float(k)), kHalf + 0.02f));
+    ASSERT_TRUE(session.grasp().active()) << "step " << k;
+  }
+}
+
+TEST(Grasp, NeedsTheThumbAndAnotherFingerOnTheBody) {
+  Block block;
+  HapticSessionSettings s;
+  const float r = s.hand.geometry.fingertipRadius;
+  // The index presses the block's side while the thumb closes in the air above it.
+  auto frame = [&](float t) {
+    HandFrame f = pinch(1.0f, kHalf);
+    f.fingertips[int(Finger::Index)] = Vec3(kHalf + r + 0.01f - 0.015f * t, kHalf, 0);
+    f.fingertips[int(Finger::Thumb)] = Vec3(0.05f - 0.04f * t, 0.15f, 0);
+    return f;
+  };
+  HapticSession session(block.world, s, frame(0));
+  bool touched = false;
+  for (int k = 1; k <= 60; ++k) {
+    touched |= session.step(frame(float(k) / 60)).fingers[int(Finger::Index)].contacts > 0;
+    EXPECT_FALSE(session.grasp().active());
+  }
+  EXPECT_TRUE(touched);
+}
+
+TEST(Grasp, DisabledGraspNeverStarts) {
+  Block block;
+  HapticSessionSettings s;
+  s.grasp.enabled = false;
+  const float r = s.hand.geometry.fingertipRadius;
+  const float open = 2 * (kHalf + r) + 0.02f, closed = 2 * (kHalf + r) - 0.02f;
+  HapticSession session(block.world, s, pinch(open, kHalf));
+  for (int k = 1; k <= 40; ++k) session.step(pinch(open + (closed - open) * float(k) / 40, kHalf));
+  EXPECT_FALSE(session.grasp().active());
+  EXPECT_GT(session.haptics().fingers[int(Finger::Thumb)].contacts, 0u);  // it pokes instead
+}
+
+TEST(Grasp, RejectsBadSettings) {
+  GraspSettings s;
+  s.releaseOpening = -1.0f;
+  EXPECT_NE(testing::errorOf([&] { Grasp g(s); }).find("releaseOpening"), std::string::npos);
+  s = {};
+  s.holdCompliance = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_NE(testing::errorOf([&] { Grasp g(s); }).find("holdCompliance"), std::string::npos);
 }
 
 }  // namespace

@@ -76,14 +76,14 @@ HapticCalibration calibrateHaptics(const World& original, BodyId body, const Hap
     world.moveFingertip(tip, start + std::min(1.0f, float(k) / float(loading)) * (end - start));
     world.step();
   }
-  const std::size_t count = world.fingertipContactCount(tip);
-  if (count == 0) throw Error(fmt::format("calibration: the poke made no contact with body {}", body));
   const float sag = down.dot(centroid(world, body) - before);
   if (sag > 0.5f * depth)
     throw Error(fmt::format(
         "calibration: body {} gave way as a whole ({:.1f} mm for a {:.1f} mm poke); rest it on something or pin it",
         body, 1e3f * sag, 1e3f * depth));
 
+  const std::size_t count = world.fingertipContactCount(tip);
+  if (count == 0) throw Error(fmt::format("calibration: the poke made no contact with body {}", body));
   HapticCalibration out;
   out.signal = base;
   out.point = point;
