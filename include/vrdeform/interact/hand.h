@@ -41,7 +41,8 @@ struct HandPose {
 struct HandFrame {
   HandPose pose;
   bool direct = false;                          ///< use `fingertips` as they are instead of the pose
-  std::array<Vec3, kFingerCount> fingertips{};  ///< world fingertip centres when direct
+  /// World fingertip centres when direct (Eigen leaves a default Vec3 uninitialised, hence the zeros).
+  std::array<Vec3, kFingerCount> fingertips{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
 };
 
 /// The centre of a fingertip sphere in world coordinates.
