@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <functional>
 #include <random>
 
@@ -180,6 +181,105 @@ TEST(Gradients, FingertipContact) {
       return evalSphereContact(q[0], q[1], 0.3).C;
     };
     expectGradientsMatch(e.n, numericGradient(C, p, 0), "fingertip contact");
+  }
+}
+
+// Distance from p to triangle (a, b, c) the plain way, independent of the Voronoi-region walk under
+// test: the projection onto the plane when it falls inside all three edges, else the nearest edge.
+double referenceTriangleDistance(const V& p, const V& a, const V& b, const V& c) {
+  const V n = (b - a).cross(c - a);
+  if ((b - a).cross(p - a).dot(n) >= 0 && (c - b).cross(p - b).dot(n) >= 0 && (a - c).cross(p - c).dot(n) >= 0)
+    return std::abs((p - a).dot(n)) / n.norm();
+  auto segment = [&](const V& s, const V& e) {
+    const double t = std::clamp((p - s).dot(e - s) / (e - s).squaredNorm(), 0.0, 1.0);
+    return (p - s - t * (e - s)).norm();
+  };
+  return std::min({segment(a, b), segment(b, c), segment(c, a)});
+}
+
+std::array<V, 3> randomTriangle(std::mt19937& rng) {
+  for (;;) {
+    const std::array<V, 3> t{randomPoint(rng), randomPoint(rng), randomPoint(rng)};
+    const double longest =
+        std::max({(t[1] - t[0]).squaredNorm(), (t[2] - t[1]).squaredNorm(), (t[0] - t[2]).squaredNorm()});
+    if ((t[1] - t[0]).cross(t[2] - t[0]).norm() > 0.1 * longest) return t;
+  }
+}
+
+// The sphere against a triangle: C = |c - q| - r with grad_{x_k} C = -b_k n and grad_c C = n. The
+// distance to a convex set is differentiable off the set, across the Voronoi regions too, so the
+// finite differences apply with the centre in the face, edge or vertex region (checked by how many
+// barycentric weights vanish; -1: any region).
+TEST(Gradients, FingertipTriangleContact) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double r = 0.3;
+  std::function<double(const std::array<V, 4>&)> C = [&](const auto& q) {
+    return evalFingertipTriangleContact(q[0], q[1], q[2], q[3], r).C;
+  };
+  auto check = [&](const std::array<V, 4>& p, int zeroWeights, const std::string& what) {
+    const auto e = evalFingertipTriangleContact(p[0], p[1], p[2], p[3], r);
+    ASSERT_NEAR(e.n.norm(), 1.0, 1e-12) << what;
+    EXPECT_NEAR(e.C + r, referenceTriangleDistance(p[3], p[0], p[1], p[2]), 1e-12) << what;
+    EXPECT_NEAR(e.b[0] + e.b[1] + e.b[2], 1.0, 1e-12) << what;
+    int zeros = 0;
+    for (double b : e.b) {
+      EXPECT_GE(b, 0.0) << what;
+      zeros += b == 0.0;
+    }
+    if (zeroWeights >= 0) {
+      EXPECT_EQ(zeros, zeroWeights) << what;
+    }
+    for (std::size_t k = 0; k < 3; ++k)
+      expectGradientsMatch(-e.b[k] * e.n, numericGradient(C, p, k), what + ", corner " + std::to_string(k));
+    expectGradientsMatch(e.n, numericGradient(C, p, 3), what + ", centre");
+  };
+  for (int trial = 0; trial < 100; ++trial) {
+    const auto t = randomTriangle(rng);
+    check({t[0], t[1], t[2], 1.5 * randomPoint(rng)}, -1, "random centre");
+  }
+  for (int trial = 0; trial < 50; ++trial) {
+    const auto t = randomTriangle(rng);
+    const V normal = (t[1] - t[0]).cross(t[2] - t[0]).normalized();
+    const double side = (u(rng) < 0.5 ? -1.0 : 1.0) * (0.05 + u(rng));  // either side of the face
+    // Face: a point inside (weights >= 0.05) lifted off the plane.
+    V b(0.05 + u(rng), 0.05 + u(rng), 0.05 + u(rng));
+    b /= b.sum();
+    check({t[0], t[1], t[2], b[0] * t[0] + b[1] * t[1] + b[2] * t[2] + side * normal}, 0, "face region");
+    // Edge k -> k+1: a point of the edge moved away from the opposite corner in the plane, and off it.
+    for (int k = 0; k < 3; ++k) {
+      const V& s = t[k];
+      const V& e = t[(k + 1) % 3];
+      const V& opposite = t[(k + 2) % 3];
+      V away = (e - s).cross(normal).normalized();
+      if (away.dot(opposite - s) > 0) away = -away;
+      const V onEdge = s + (0.1 + 0.8 * u(rng)) * (e - s);
+      check({t[0], t[1], t[2], onEdge + (0.05 + u(rng)) * away + 0.5 * side * normal}, 1,
+            "edge region " + std::to_string(k));
+    }
+    // Vertex k: beyond the corner, against both of its edges.
+    for (int k = 0; k < 3; ++k) {
+      const V& corner = t[k];
+      const V out = -((t[(k + 1) % 3] - corner).normalized() + (t[(k + 2) % 3] - corner).normalized());
+      check({t[0], t[1], t[2], corner + (0.05 + u(rng)) * out + 0.5 * side * normal}, 2,
+            "vertex region " + std::to_string(k));
+    }
+  }
+}
+
+TEST(Gradients, FingertipTriangleContactOnTheTriangleAndDegenerate) {
+  // The centre on the face: no direction from c - q, so the triangle's (outward) unit normal.
+  const V a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  const auto on = evalFingertipTriangleContact(a, b, c, V(0.25, 0.25, 0.0), 0.1);
+  EXPECT_NEAR(on.C, -0.1, 1e-15);
+  EXPECT_TRUE(on.n.isApprox(V(0, 0, 1)));
+  const auto onEdge = evalFingertipTriangleContact(a, b, c, V(0.5, 0.0, 0.0), 0.1);
+  EXPECT_TRUE(onEdge.n.isApprox(V(0, 0, 1)));
+  // Zero area (a corner on the opposite edge, or two corners coincident): no contact.
+  for (const auto& e : {evalFingertipTriangleContact(a, b, V(0.5, 0, 0), V(0.5, 0.05, 0.0), 0.1),
+                        evalFingertipTriangleContact(a, a, c, V(0.0, 0.5, 0.05), 0.1)}) {
+    EXPECT_TRUE(e.n.isZero());
+    EXPECT_EQ(e.b[0] + e.b[1] + e.b[2], 0.0);
   }
 }
 

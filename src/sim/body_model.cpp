@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "vrdeform/error.h"
+#include "vrdeform/mesh/boundary.h"
 #include "vrdeform/sim/lane_batches.h"
 
 namespace vrd {
@@ -142,6 +143,7 @@ std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Materia
   model->restPositions = mesh.vertices;
   const LaneOrder tetOrder = orderForLanes(mesh.tets);
   model->tets = permuted(mesh.tets, tetOrder.order);
+  model->surface = boundaryFaces(mesh);  // indexes mesh.vertices = restPositions; by the mesh's tet order
   model->damping = dampingOf(material);
   model->particleRadius = material.particleRadius;
 
@@ -222,6 +224,7 @@ std::shared_ptr<const BodyModel> makeCloth(const TriMesh& mesh, const Material& 
   auto model = std::make_shared<BodyModel>();
   model->restPositions = mesh.vertices;
   model->triangles = mesh.triangles;
+  model->surface = mesh.triangles;
   model->invMass.assign(mesh.vertices.size(), 1.0f / material.particleMass);
   model->damping = dampingOf(material);
   model->particleRadius = material.particleRadius;
@@ -286,6 +289,16 @@ void validateModel(const BodyModel& model) {
   for (std::size_t t = 0; t < model.triangles.size(); ++t)
     for (Index v : model.triangles[t])
       if (v >= n) throw Error(fmt::format("triangle {} refers to particle {}, but the body has {} particles", t, v, n));
+  for (std::size_t t = 0; t < model.surface.size(); ++t) {
+    const Triangle& tri = model.surface[t];
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (tri[k] >= n)
+        throw Error(fmt::format("surface triangle {} ({}, {}, {}) refers to particle {}, but the body has {} particles",
+                                t, tri[0], tri[1], tri[2], tri[k], n));
+      for (std::size_t j = 0; j < k; ++j)
+        if (tri[j] == tri[k]) throw Error(fmt::format("surface triangle {} uses particle {} twice", t, tri[k]));
+    }
+  }
   if (const auto& sm = model.shapeMatching) {
     if (sm->restOffsets.size() != n || sm->mass.size() != n)
       throw Error("shape matching rest frame does not match the body's particle count");

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <type_traits>
 #include <utility>
@@ -23,6 +24,11 @@ void checkFinite(const Vec3& v, const char* what) {
 void checkCompliance(float compliance, const char* what) {
   if (!(std::isfinite(compliance) && compliance >= 0.0f))
     throw Error(fmt::format("{}: compliance must be finite and >= 0, got {}", what, compliance));
+}
+
+void checkContactMode(FingertipContactMode mode, const char* what) {
+  if (mode != FingertipContactMode::Particles && mode != FingertipContactMode::Triangles)
+    throw Error(fmt::format("{}: unknown fingertip contact mode {}", what, int(mode)));
 }
 
 // Zeroes a body's multipliers (Algorithm 1, line 9).
@@ -136,12 +142,13 @@ ColliderId World::addCollider(const Collider& collider) {
   return ColliderId(colliders_.size() - 1);
 }
 
-FingertipId World::addFingertip(const Vec3& center, float radius, float compliance) {
+FingertipId World::addFingertip(const Vec3& center, float radius, float compliance, FingertipContactMode mode) {
   checkFinite(center, "addFingertip centre");
   if (!(std::isfinite(radius) && radius > 0.0f))
     throw Error(fmt::format("addFingertip: radius must be positive, got {}", radius));
   checkCompliance(compliance, "addFingertip");
-  fingertips_.push_back({center, center, radius, compliance});
+  checkContactMode(mode, "addFingertip");
+  fingertips_.push_back({center, center, radius, compliance, true, mode});
   return FingertipId(fingertips_.size() - 1);
 }
 
@@ -152,6 +159,11 @@ void World::moveFingertip(FingertipId id, const Vec3& goal) {
 
 void World::setFingertipEnabled(FingertipId id, bool enabled) { fingertips_.at(id).enabled = enabled; }
 
+void World::setFingertipContactMode(FingertipId id, FingertipContactMode mode) {
+  checkContactMode(mode, "setFingertipContactMode");
+  fingertips_.at(id).mode = mode;
+}
+
 Vec3 World::fingertipForce(FingertipId id) const {
   const float h = substepSize();
   Vec3 force = Vec3::Zero();
@@ -160,6 +172,9 @@ Vec3 World::fingertipForce(FingertipId id) const {
     if (fingertipContacts_[c].fingertip == id)
       force += fingertipLambda_[c] *
                evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, f.center, f.radius).n;
+  for (std::size_t c = 0; c < fingertipTriangleContacts_.size(); ++c)
+    if (fingertipTriangleContacts_[c].fingertip == id)
+      for (const Vec3& impulse : fingertipTriangleImpulse_[c]) force += impulse;
   return force / (h * h);
 }
 
@@ -167,6 +182,8 @@ std::size_t World::fingertipContactCount(FingertipId id) const {
   std::size_t count = 0;
   for (std::size_t c = 0; c < fingertipContacts_.size(); ++c)
     count += fingertipContacts_[c].fingertip == id && fingertipLambda_[c] > 0.0f;
+  for (std::size_t c = 0; c < fingertipTriangleContacts_.size(); ++c)
+    count += fingertipTriangleContacts_[c].fingertip == id && fingertipTriangleLambda_[c] > 0.0f;
   return count;
 }
 
@@ -174,6 +191,8 @@ float World::fingertipLambdaSum(FingertipId id) const {
   float sum = 0.0f;
   for (std::size_t c = 0; c < fingertipContacts_.size(); ++c)
     if (fingertipContacts_[c].fingertip == id) sum += std::abs(fingertipLambda_[c]);
+  for (std::size_t c = 0; c < fingertipTriangleContacts_.size(); ++c)
+    if (fingertipTriangleContacts_[c].fingertip == id) sum += std::abs(fingertipTriangleLambda_[c]);
   return sum;
 }
 
@@ -196,10 +215,12 @@ void World::step() {
     for (int it = 0; it < settings_.iterations; ++it) solveIteration(h);
     finalise(h);
   }
-  report_.colliderContacts = std::size_t(
-      std::count_if(contactNormalLambda_.begin(), contactNormalLambda_.end(), [](float l) { return l > 0.0f; }));
+  const auto pushed = [](float l) { return l > 0.0f; };
+  report_.colliderContacts =
+      std::size_t(std::count_if(contactNormalLambda_.begin(), contactNormalLambda_.end(), pushed));
   report_.fingertipContacts =
-      std::size_t(std::count_if(fingertipLambda_.begin(), fingertipLambda_.end(), [](float l) { return l > 0.0f; }));
+      std::size_t(std::count_if(fingertipLambda_.begin(), fingertipLambda_.end(), pushed) +
+                  std::count_if(fingertipTriangleLambda_.begin(), fingertipTriangleLambda_.end(), pushed));
   ++stepCount_;
 }
 
@@ -236,9 +257,45 @@ void World::detectContacts() {
       // Eq. 36: N(r) from the predicted positions, widened by the same margin plus a skin, so that
       // a particle resting on the fingertip is not dropped when its prediction lands just outside.
       for (Index f = 0; f < fingertips_.size(); ++f) {
-        if (!fingertips_[f].enabled) continue;
+        if (!fingertips_[f].enabled || fingertips_[f].mode != FingertipContactMode::Particles) continue;
         const float reach = fingertips_[f].radius * (1.0f + kFingertipSkin) + motion;
         if ((p.pos - fingertips_[f].center).squaredNorm() <= reach * reach) fingertipContacts_.push_back({i, f});
+      }
+    }
+  }
+  detectTriangleContacts();
+}
+
+// Fingertips in Triangles mode against the active bodies' surface triangles, from the predicted
+// positions (eq. 36 with the closest point of a triangle in place of a particle). Triangles whose
+// corners are all kinematic cannot be pushed and are skipped.
+void World::detectTriangleContacts() {
+  fingertipTriangleContacts_.clear();
+  if (std::none_of(fingertips_.begin(), fingertips_.end(),
+                   [](const Fingertip& f) { return f.enabled && f.mode == FingertipContactMode::Triangles; }))
+    return;
+  const Point* const pred = particles_.p.data();
+  const Point* const start = particles_.x.data();
+  for (const Body& b : bodies_) {
+    if (b.state != BodyState::Active) continue;
+    for (const Triangle& t : b.model->surface) {
+      const Index i[3] = {b.firstParticle + t[0], b.firstParticle + t[1], b.firstParticle + t[2]};
+      const Point &p0 = pred[i[0]], &p1 = pred[i[1]], &p2 = pred[i[2]];
+      if (p0.w == 0.0f && p1.w == 0.0f && p2.w == 0.0f) continue;
+      // The same margin as for particles: the farthest predicted motion of a corner, plus the skin.
+      const float motion =
+          std::sqrt(std::max({(p0.pos - start[i[0]].pos).squaredNorm(), (p1.pos - start[i[1]].pos).squaredNorm(),
+                              (p2.pos - start[i[2]].pos).squaredNorm()}));
+      const Vec3 lo = p0.pos.cwiseMin(p1.pos).cwiseMin(p2.pos), hi = p0.pos.cwiseMax(p1.pos).cwiseMax(p2.pos);
+      for (Index f = 0; f < fingertips_.size(); ++f) {
+        const Fingertip& tip = fingertips_[f];
+        if (!tip.enabled || tip.mode != FingertipContactMode::Triangles) continue;
+        const float reach = tip.radius * (1.0f + kFingertipSkin) + motion;
+        if (((tip.center.array() + reach) < lo.array()).any() || ((tip.center.array() - reach) > hi.array()).any())
+          continue;  // the triangle's box is out of reach
+        const TriangleContactEval<float> e =
+            evalFingertipTriangleContact(p0.pos, p1.pos, p2.pos, tip.center, tip.radius);
+        if (!e.n.isZero() && e.C + tip.radius <= reach) fingertipTriangleContacts_.push_back({{i[0], i[1], i[2]}, f});
       }
     }
   }
@@ -250,6 +307,8 @@ void World::resetMultipliers() {
   contactNormalLambda_.assign(colliderContacts_.size(), 0.0f);
   contactFrictionLambda_.assign(colliderContacts_.size(), Vec3::Zero());
   fingertipLambda_.assign(fingertipContacts_.size(), 0.0f);
+  fingertipTriangleLambda_.assign(fingertipTriangleContacts_.size(), 0.0f);
+  fingertipTriangleImpulse_.assign(fingertipTriangleContacts_.size(), {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
 }
 
 void World::solveIteration(float h) {
@@ -332,7 +391,7 @@ void World::solveIteration(float h) {
       q.pos += r.dp;
     }
   }
-  if (!fingertipContacts_.empty()) {
+  if (!fingertipContacts_.empty() || !fingertipTriangleContacts_.empty()) {
     StageTimer t(times, Stage::Fingertip, timed);
     for (std::size_t c = 0; c < fingertipContacts_.size(); ++c) {
       const FingertipContact& con = fingertipContacts_[c];
@@ -342,6 +401,19 @@ void World::solveIteration(float h) {
                                                           XpbdCoefficients::make(f.compliance, 0.0f, invH));
       fingertipLambda_[c] += r.dLambda;
       q.pos += r.dp[0];
+    }
+    for (std::size_t c = 0; c < fingertipTriangleContacts_.size(); ++c) {
+      const FingertipTriangleContact& con = fingertipTriangleContacts_[c];
+      const Fingertip& f = fingertips_[con.fingertip];
+      Point &q0 = pred[con.i[0]], &q1 = pred[con.i[1]], &q2 = pred[con.i[2]];
+      const TriangleContactCorrection r =
+          solveFingertipTriangleContact(q0, q1, q2, f.center, f.radius, fingertipTriangleLambda_[c],
+                                        XpbdCoefficients::make(f.compliance, 0.0f, invH));
+      fingertipTriangleLambda_[c] += r.dLambda;
+      for (int k = 0; k < 3; ++k) fingertipTriangleImpulse_[c][k] += r.dLambda * r.grad[k];
+      q0.pos += r.dp[0];
+      q1.pos += r.dp[1];
+      q2.pos += r.dp[2];
     }
   }
 }
@@ -457,6 +529,9 @@ std::vector<Vec3> World::particleConstraintForces(BodyId id) const {
       *fi += fingertipLambda_[c] * invH2 *
              evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, tip.center, tip.radius).n;
     }
+  for (std::size_t c = 0; c < fingertipTriangleContacts_.size(); ++c)
+    for (int k = 0; k < 3; ++k)
+      if (Vec3* fi = local(fingertipTriangleContacts_[c].i[k])) *fi += fingertipTriangleImpulse_[c][k] * invH2;
   return f;
 }
 

@@ -38,6 +38,8 @@ struct BodyModel {
   std::vector<Tet> tets;            ///< the volume elements (soft bodies), in solver order; volume[j] and
                                     ///< strain[j], when present, belong to tets[j]
   std::vector<Triangle> triangles;  ///< the cloth triangles (cloth)
+  std::vector<Triangle> surface;    ///< outward surface triangles that fingertips in Triangles mode touch: a
+                                    ///< soft body's boundaryFaces(), a cloth's triangles; may be empty
 
   std::vector<DistanceConstraint> distance;
   std::vector<VolumeConstraint> volume;
@@ -73,7 +75,8 @@ void addDistanceConstraint(BodyModel& model, Index a, Index b, float compliance)
 ShapeMatchModel makeShapeMatchModel(const BodyModel& model, float compliance);
 
 /// Checks a hand-built or loaded model: finite positions, inverse masses finite and >= 0,
-/// constraint indices in range, finite non-negative compliances. Throws vrd::Error naming the item.
+/// constraint, tet, triangle and surface triangle indices in range, finite non-negative compliances. Throws vrd::Error
+/// naming the item.
 void validateModel(const BodyModel& model);
 
 }  // namespace vrd

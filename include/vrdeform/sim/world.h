@@ -2,6 +2,7 @@
 // A simulation world: bodies, attachments, colliders and fingertips, stepped with XPBD
 // (Algorithm 1) by one serial Gauss-Seidel solver.
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -30,7 +31,7 @@ struct StepReport {
   std::uint64_t step = 0;             ///< index of the step (0-based)
   StageTimes times;                   ///< summed over substeps and iterations
   std::size_t colliderContacts = 0;   ///< contacts that pushed (lambda > 0) in the last substep
-  std::size_t fingertipContacts = 0;  ///< fingertip contacts that pushed in the last substep
+  std::size_t fingertipContacts = 0;  ///< fingertip contacts (particles and triangles) that pushed in the last substep
 };
 
 class World {
@@ -76,18 +77,25 @@ class World {
   ColliderId addCollider(const Collider& collider);
   const std::vector<Collider>& colliders() const { return colliders_; }
 
-  FingertipId addFingertip(const Vec3& center, float radius, float compliance = 0.0f);
+  /// Adds a kinematic contact sphere; `mode` says whether it touches the bodies' particles (the
+  /// paper) or their surface triangles (BodyModel::surface).
+  FingertipId addFingertip(const Vec3& center, float radius, float compliance = 0.0f,
+                           FingertipContactMode mode = FingertipContactMode::Particles);
   /// Moves a fingertip's centre to `goal` over the next step.
   void moveFingertip(FingertipId id, const Vec3& goal);
   /// Switches a fingertip's contacts on or off; off, it passes through bodies (N(r) = {}, eq. 36).
   void setFingertipEnabled(FingertipId id, bool enabled);
+  /// Switches what the fingertip touches; takes effect at the next substep.
+  void setFingertipContactMode(FingertipId id, FingertipContactMode mode);
   const Fingertip& fingertip(FingertipId id) const { return fingertips_.at(id); }
   std::size_t fingertipCount() const { return fingertips_.size(); }
-  /// Total force the fingertip applied to the bodies in the last substep (N).
+  /// Total force the fingertip applied to the bodies in the last substep (N): lambda n / h^2 summed
+  /// over its particle contacts, and the impulse its triangle contacts applied, / h^2.
   Vec3 fingertipForce(FingertipId id) const;
-  /// Number of particles the fingertip pushed in the last substep (contacts with lambda > 0).
+  /// Number of particles (or, in Triangles mode, surface triangles) the fingertip pushed in the
+  /// last substep (contacts with lambda > 0).
   std::size_t fingertipContactCount(FingertipId id) const;
-  /// Sum of |lambda^C| over the fingertip's contacts in the last substep: eq. 40's numerator.
+  /// Sum of |lambda^C| over the fingertip's contacts (of either mode) in the last substep: eq. 40's numerator.
   float fingertipLambdaSum(FingertipId id) const;
 
   const std::vector<ColliderContact>& colliderContacts() const { return colliderContacts_; }
@@ -95,6 +103,9 @@ class World {
   const std::vector<Vec3>& colliderContactFrictionLambda() const { return contactFrictionLambda_; }
   const std::vector<FingertipContact>& fingertipContacts() const { return fingertipContacts_; }
   const std::vector<float>& fingertipContactLambda() const { return fingertipLambda_; }
+  /// Contacts of fingertips in Triangles mode, and their multipliers (same order).
+  const std::vector<FingertipTriangleContact>& fingertipTriangleContacts() const { return fingertipTriangleContacts_; }
+  const std::vector<float>& fingertipTriangleContactLambda() const { return fingertipTriangleLambda_; }
 
   // --- Stepping ---------------------------------------------------------------------------------
   /// Advances the world by one time step: `substeps` x (predict, detect, `iterations` Gauss-Seidel
@@ -112,12 +123,15 @@ class World {
   double volumeLoss(BodyId id) const;
   /// Net constraint force on each of the body's particles in the last substep (N):
   /// sum over every constraint j acting on particle i of grad_i C_j lambda_j / h^2, including
-  /// attachments and contacts. At rest it balances the particle's weight and external force.
+  /// attachments and contacts (for fingertip triangle contacts, whose gradient turns with the
+  /// triangle, the impulse applied: sum over the iterations of grad_i C dLambda, / h^2). At rest it
+  /// balances the particle's weight and external force.
   std::vector<Vec3> particleConstraintForces(BodyId id) const;
 
  private:
   void predict(float h);
   void detectContacts();
+  void detectTriangleContacts();
   void resetMultipliers();
   void solveIteration(float h);
   void finalise(float h);
@@ -135,6 +149,9 @@ class World {
   std::vector<Fingertip> fingertips_;
   std::vector<FingertipContact> fingertipContacts_;
   std::vector<float> fingertipLambda_;
+  std::vector<FingertipTriangleContact> fingertipTriangleContacts_;
+  std::vector<float> fingertipTriangleLambda_;
+  std::vector<std::array<Vec3, 3>> fingertipTriangleImpulse_;  // per corner: sum of grad C dLambda this substep
   std::vector<SimEvent> events_;
   StepReport report_;
   std::uint64_t stepCount_ = 0;
