@@ -25,6 +25,10 @@ std::optional<BodyId> touchedBody(const World& world, FingertipId tip) {
   const auto& lambda = world.fingertipContactLambda();
   for (std::size_t c = 0; c < contacts.size(); ++c)
     if (contacts[c].fingertip == tip && lambda[c] > 0.0f) return bodyOf(world, contacts[c].particle);
+  const auto& triangles = world.fingertipTriangleContacts();
+  const auto& triangleLambda = world.fingertipTriangleContactLambda();
+  for (std::size_t c = 0; c < triangles.size(); ++c)
+    if (triangles[c].fingertip == tip && triangleLambda[c] > 0.0f) return bodyOf(world, triangles[c].i[0]);
   return std::nullopt;
 }
 

@@ -11,7 +11,8 @@ HandRig::HandRig(World& world, const HandRigSettings& settings, const HandFrame&
   for (int f = 0; f < kFingerCount; ++f) {
     if (!settings.fingers[f]) continue;
     if (!isFinite(targets_[f])) throw Error("hand: the initial frame puts a fingertip at a non-finite position");
-    tips_[f] = world.addFingertip(targets_[f], settings.geometry.fingertipRadius, settings.compliance);
+    tips_[f] =
+        world.addFingertip(targets_[f], settings.geometry.fingertipRadius, settings.compliance, settings.contact);
   }
   if (!initial.direct) wrist_ = initial.pose.wrist;
 }

@@ -19,12 +19,13 @@
 namespace vrd {
 
 struct CalibrationSettings {
-  float radius = 0.009f;            ///< fingertip radius (m)
-  float depth = 0.0f;               ///< indentation (m); 0 = the radius
-  float duration = 1.0f;            ///< loading time (s)
-  float contactTarget = 1.0f;       ///< normalised contact multiplier at full depth
-  float volumeStrainTarget = 0.8f;  ///< F_VS at full depth
-  std::optional<Vec3> point;        ///< poke this surface point instead of the highest particle
+  float radius = 0.009f;                                           ///< fingertip radius (m)
+  FingertipContactMode contact = FingertipContactMode::Particles;  ///< as the hand that will use the result
+  float depth = 0.0f;                                              ///< indentation (m); 0 = the radius
+  float duration = 1.0f;                                           ///< loading time (s)
+  float contactTarget = 1.0f;                                      ///< normalised contact multiplier at full depth
+  float volumeStrainTarget = 0.8f;                                 ///< F_VS at full depth
+  std::optional<Vec3> point;  ///< poke this surface point instead of the highest particle
 };
 
 struct HapticCalibration {

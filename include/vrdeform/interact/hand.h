@@ -40,7 +40,7 @@ struct HandPose {
 /// centres given directly (tracked hands, controllers, mouse).
 struct HandFrame {
   HandPose pose;
-  bool direct = false;                          ///< use `fingertips` as they are instead of the pose
+  bool direct = false;  ///< use `fingertips` as they are instead of the pose
   /// World fingertip centres when direct (Eigen leaves a default Vec3 uninitialised, hence the zeros).
   std::array<Vec3, kFingerCount> fingertips{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
 };

@@ -14,6 +14,9 @@ struct HandRigSettings {
   HandGeometry geometry = HandGeometry::average();                         ///< kinematic hand for pose-driven frames
   std::array<bool, kFingerCount> fingers{true, true, true, false, false};  ///< fingers with a fingertip (G1)
   float compliance = 0.0f;  ///< alpha of the fingertip contacts (m/N); 0 = rigid fingertips
+  /// Particles: the paper's contacts (eqs. 36-39). Triangles: against the bodies' surface
+  /// triangles, so a fingertip pressing between the vertices of a coarse mesh still touches.
+  FingertipContactMode contact = FingertipContactMode::Particles;
 
   static HandRigSettings g1() { return {}; }
   static HandRigSettings pro() {
