@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <numeric>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "test_support.h"
 #include "vrdeform/haptics/calibration.h"
 #include "vrdeform/haptics/haptic_session.h"
+#include "vrdeform/interact/hand_script.h"
 #include "vrdeform/io/surface_io.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/mesh/tetrahedralise.h"
@@ -296,6 +298,60 @@ TEST(HapticSession, BaselineGrowsWithDepthOnlyAgainstRigidColliders) {
     EXPECT_NEAR(b, s.haptics.baseline.contactForce + s.haptics.baseline.stiffness * depth, 1e-5f);
   }
   EXPECT_EQ(session.step(tipsAt(Vec3(0, -1, 0))).fingers[int(Finger::Index)].baseline, 1.0f);  // clipped
+}
+
+TEST(HapticSession, RecordedSessionReplaysBitForBit) {
+  // A glove-style script (wrist pose and closures) presses the hand onto the liver while closing
+  // it; the recording, saved and loaded, drives a fresh copy of the scene to the same bits.
+  HapticSessionSettings s;
+  s.hand = HandRigSettings::pro();
+  s.grasp.mode = GraspMode::Local;
+  const Quat palmDown(Eigen::AngleAxisf(1.5708f, Vec3::UnitX()));
+  std::vector<HandKeyframe> keys;
+  {
+    const Liver probe;  // where the index fingertip must be
+    HandPose pose;
+    pose.wrist.linear() = palmDown.toRotationMatrix();
+    pose.closure.fill(0.2f);
+    const Vec3 reach = fingertipPosition(s.hand.geometry, pose, Finger::Index);  // with the wrist at the origin
+    const Vec3 wrist = probe.top + Vec3(0, 0.01f, 0) - reach;
+    keys.push_back({0.0, wrist, palmDown, {0.2f, 0.2f, 0.2f, 0.2f, 0.2f}});
+    keys.push_back({1.0, wrist - Vec3(0, 0.025f, 0), palmDown, {0.6f, 0.5f, 0.5f, 0.4f, 0.4f}});
+    keys.push_back({1.5, wrist + Vec3(0, 0.03f, 0), palmDown, {0.0f, 0.0f, 0.0f, 0.0f, 0.0f}});
+  }
+  HandScriptInput script{HandScript(keys)};
+  SessionRecording recording;
+  recording.settings = {{"scene", "liver"}};
+  std::vector<Point> finalPositions;
+  bool felt = false;
+  {
+    Liver liver;
+    HapticSession session(liver.world, s, script.frame(0, 0.0));
+    const std::uint64_t steps = session.run(script, 1000, &recording);  // 0 .. 1.5 s at 60 Hz
+    EXPECT_TRUE(steps == 90u || steps == 91u) << steps;                 // the last one, at 1.5 s, is rounding
+    finalPositions = liver.world.particles().x;
+    for (const RecordedStep& r : recording.steps)
+      for (float v : r.outputs) felt |= v > 0.0f;
+  }
+  ASSERT_TRUE(felt);  // the hand did touch the body
+
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "vrdeform_replay_test.session";
+  recording.save(file);
+  RecordingInput replay(SessionRecording::load(file));
+  std::filesystem::remove(file);
+  Liver liver;
+  HapticSession session(liver.world, s, replay.frame(0, 0.0));
+  SessionRecording again;
+  EXPECT_EQ(session.run(replay, 1000, &again), recording.steps.size());
+  for (std::size_t k = 0; k < recording.steps.size(); ++k) {
+    const auto& a = recording.steps[k].outputs;
+    const auto& b = again.steps[k].outputs;
+    ASSERT_EQ(a.size(), b.size());
+    ASSERT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << "step " << k;
+  }
+  ASSERT_EQ(finalPositions.size(), liver.world.particles().x.size());
+  for (std::size_t i = 0; i < finalPositions.size(); ++i)
+    ASSERT_EQ(std::memcmp(&finalPositions[i].pos, &liver.world.particles().x[i].pos, sizeof(Vec3)), 0) << i;
 }
 
 }  // namespace

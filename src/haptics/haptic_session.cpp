@@ -21,7 +21,26 @@ const HapticFrame& HapticSession::step(const HandFrame& input) {
   times_ = world_.lastStep().times;
   times_[Stage::Interact] = own[Stage::Interact];
   times_[Stage::Force] = own[Stage::Force];
+  ++steps_;
   return haptics_.frame();
+}
+
+std::uint64_t HapticSession::run(HandInput& input, std::uint64_t maxSteps, SessionRecording* record) {
+  std::uint64_t done = 0;
+  for (; done < maxSteps; ++done) {
+    const double time = double(steps_) * world_.settings().timeStep;
+    if (input.finished(steps_, time)) break;
+    const HandFrame frame = input.frame(steps_, time);
+    step(frame);
+    if (record) record->steps.push_back({frame, recordedOutputs(haptics())});
+  }
+  return done;
+}
+
+std::vector<float> recordedOutputs(const HapticFrame& frame) {
+  std::vector<float> out{frame.paper, frame.paperRaw};
+  for (const FingerHaptics& f : frame.fingers) out.insert(out.end(), {f.force, f.raw, f.newtons, f.baseline});
+  return out;
 }
 
 }  // namespace vrd

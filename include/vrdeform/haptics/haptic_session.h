@@ -2,9 +2,14 @@
 // One user's hand on a world, stepped as Algorithm 2: hand input -> grasp -> XPBD step -> haptic
 // force. Single-threaded and deterministic: the same world and inputs give the same bits.
 
+#include <cstdint>
+#include <vector>
+
 #include "vrdeform/haptics/haptic_model.h"
 #include "vrdeform/interact/grasp.h"
+#include "vrdeform/interact/hand_input.h"
 #include "vrdeform/interact/hand_rig.h"
+#include "vrdeform/interact/session_recording.h"
 
 namespace vrd {
 
@@ -22,6 +27,9 @@ class HapticSession {
   /// One step: moves the hand to `input`, starts/ends/follows a grasp, steps the world and
   /// computes the haptic outputs.
   const HapticFrame& step(const HandFrame& input);
+  /// Steps through `input` (step k at time k dt from this session's first step) until it is
+  /// finished or `maxSteps` have run; appends each step to `record` when given. Returns the steps run.
+  std::uint64_t run(HandInput& input, std::uint64_t maxSteps, SessionRecording* record = nullptr);
 
   World& world() { return world_; }
   const World& world() const { return world_; }
@@ -37,6 +45,11 @@ class HapticSession {
   Grasp grasp_;
   HapticModel haptics_;
   StageTimes times_;
+  std::uint64_t steps_ = 0;
 };
+
+/// The values a recording keeps per step, in this order: paper, paperRaw, then per finger force,
+/// raw, newtons, baseline.
+std::vector<float> recordedOutputs(const HapticFrame& frame);
 
 }  // namespace vrd
