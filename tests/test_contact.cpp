@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "block_on_ground.h"
 #include "test_support.h"
 
 #include <cmath>
@@ -91,37 +92,7 @@ TEST(Contact, RestsOnSphereAndBoxAtItsRadius) {
   EXPECT_NEAR(w.particles().x[w.particleIndex(onBox, 0)].pos.y(), 0.32f, 1e-4f);
 }
 
-// A soft block resting on the ground, its particles' weight carried by the ground contacts.
-struct BlockOnGround {
-  World world;
-  BodyId body;
-  float weight;
-
-  explicit BlockOnGround(int substeps = 1) : world(settings(substeps)) {
-    Material m;
-    m.elastic = ElasticModuli{2e4f, 0.3f, 1000.0f};
-    const TetMesh mesh =
-        makeBoxTets(Vec3(-0.05f, 0.0f, -0.05f), Vec3(0.1f, 0.1f, 0.1f), 4, 4, 4);  // a vertex at the top centre
-    body = world.addBody(makeSoftBody(mesh, m, {false, true, true, false}));
-    world.addCollider(Collider::plane(Vec3::UnitY()));
-    weight = 1000.0f * 1e-3f * kG;  // rho V g
-  }
-  static SolverSettings settings(int substeps) {
-    SolverSettings s;
-    s.substeps = substeps;
-    s.iterations = 20;
-    s.linearDamping = 10.0f;
-    return s;
-  }
-  // Vertical force the ground pushes with, from the contact multipliers.
-  float groundReaction() const {
-    const float h = world.substepSize();
-    double sum = 0.0;
-    const auto& lambda = world.colliderContactNormalLambda();
-    for (std::size_t c = 0; c < lambda.size(); ++c) sum += lambda[c];  // ground normal is +y
-    return float(sum / (h * h));
-  }
-};
+using testing::BlockOnGround;
 
 TEST(Contact, GroundReactionEqualsWeightAtRest) {
   BlockOnGround block;
@@ -137,16 +108,24 @@ TEST(Contact, GroundReactionEqualsWeightAtRest) {
 
 TEST(Contact, FingertipPushBalancesGroundReaction) {
   // validation.md V12a: a kinematic sphere pressed into a block on the ground; at rest the
-  // fingertip force equals the ground reaction minus the weight, to 1e-3.
-  BlockOnGround block;
-  const FingertipId tip = block.world.addFingertip(Vec3(0.0f, 0.2f, 0.0f), 0.03f);
-  for (int step = 0; step < 60; ++step) block.world.step();                // settle first
-  block.world.moveFingertip(tip, Vec3(0.0f, 0.1f + 0.03f - 0.01f, 0.0f));  // 1 cm into the top face
-  for (int step = 0; step < 300; ++step) block.world.step();
-  const Vec3 push = block.world.fingertipForce(tip);
-  ASSERT_GT(block.world.fingertipContactCount(tip), 0u);
-  ASSERT_GT(-push.y(), 0.1f * block.weight);  // a real push, not noise
-  EXPECT_NEAR(-push.y(), block.groundReaction() - block.weight, 1e-3f * block.groundReaction());
+  // fingertip force equals the ground reaction minus the weight, to 1e-3, whether it touches the
+  // particles (eqs. 36-39) or the surface triangles.
+  for (FingertipContactMode mode : {FingertipContactMode::Particles, FingertipContactMode::Triangles}) {
+    SCOPED_TRACE(mode == FingertipContactMode::Particles ? "particles" : "triangles");
+    BlockOnGround block;
+    const FingertipId tip = block.world.addFingertip(Vec3(0.0f, 0.2f, 0.0f), 0.03f, 0.0f, mode);
+    for (int step = 0; step < 60; ++step) block.world.step();                // settle first
+    block.world.moveFingertip(tip, Vec3(0.0f, 0.1f + 0.03f - 0.01f, 0.0f));  // 1 cm into the top face
+    for (int step = 0; step < 300; ++step) block.world.step();
+    const Vec3 push = block.world.fingertipForce(tip);
+    ASSERT_GT(block.world.fingertipContactCount(tip), 0u);
+    ASSERT_GT(-push.y(), 0.1f * block.weight);  // a real push, not noise
+    EXPECT_NEAR(-push.y(), block.groundReaction() - block.weight, 1e-3f * block.groundReaction());
+    // The per-particle readout includes the fingertip contacts: the net constraint force is the weight.
+    Vec3 total = Vec3::Zero();
+    for (const Vec3& f : block.world.particleConstraintForces(block.body)) total += f;
+    EXPECT_NEAR(total.y(), block.weight, 1e-3f * block.groundReaction());
+  }
 }
 
 TEST(Contact, FingertipForceDoesNotDependOnTheSubstep) {
@@ -157,7 +136,7 @@ TEST(Contact, FingertipForceDoesNotDependOnTheSubstep) {
   // goes 1.5 cm deep so that it rests on several particles, not balanced on one.
   float force[2];
   for (int n : {2, 4}) {
-    BlockOnGround block(n);
+    BlockOnGround block(0.1f, 4, n);
     SolverSettings s = block.world.settings();
     s.iterations = 50;
     block.world.setSettings(s);

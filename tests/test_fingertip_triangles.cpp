@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "block_on_ground.h"
 #include "test_support.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/world.h"
@@ -64,35 +65,9 @@ TEST(FingertipTriangles, KinematicAndDegenerateTrianglesDoNothing) {
 
 // --- A block on the ground ---------------------------------------------------------------------
 
-// A soft cube of side `size` and `cells`^3 cells resting on the ground (tests/test_contact.cpp).
-struct BlockOnGround {
-  World world;
-  BodyId body;
-  float size, weight;
-
-  BlockOnGround(float side, int cells, int substeps = 1) : world(settings(substeps)), size(side) {
-    Material m;
-    m.elastic = ElasticModuli{2e4f, 0.3f, 1000.0f};
-    const TetMesh mesh =
-        makeBoxTets(Vec3(-0.5f * side, 0.0f, -0.5f * side), Vec3(side, side, side), cells, cells, cells);
-    body = world.addBody(makeSoftBody(mesh, m, {false, true, true, false}));
-    world.addCollider(Collider::plane(Vec3::UnitY()));
-    weight = 1000.0f * side * side * side * kG;  // rho V g
-  }
-  static SolverSettings settings(int substeps) {
-    SolverSettings s;
-    s.substeps = substeps;
-    s.iterations = 20;
-    s.linearDamping = 10.0f;
-    return s;
-  }
-  float groundReaction() const {
-    const float h = world.substepSize();
-    double sum = 0.0;
-    for (float lambda : world.colliderContactNormalLambda()) sum += lambda;  // ground normal is +y
-    return float(sum / (h * h));
-  }
-  Vec3 position(Index local) const { return world.particles().x[world.particleIndex(body, local)].pos; }
+// The V12 block (block_on_ground.h) with what these tests read off its surface.
+struct BlockOnGround : testing::BlockOnGround {
+  using testing::BlockOnGround::BlockOnGround;
   // Centroid, now, of the first surface triangle in the top face (the block sags under its weight).
   Vec3 topTriangleCentroid() const {
     const BodyModel& m = *world.body(body).model;
@@ -199,25 +174,6 @@ TEST(FingertipTriangles, TrianglesModePushesTheFaceBetweenVertices) {
   EXPECT_LT(push.y(), 0.0f);
   EXPECT_LT(push.head<1>().norm() + std::abs(push.z()), 0.2f * -push.y());
   EXPECT_NEAR(-push.y(), block.groundReaction() - block.weight, 1e-3f * block.groundReaction());
-}
-
-TEST(FingertipTriangles, PushBalancesGroundReaction) {
-  // validation.md V12a in Triangles mode, mirroring Contact.FingertipPushBalancesGroundReaction:
-  // at rest the fingertip force equals the ground reaction minus the weight, to 1e-3.
-  BlockOnGround block(0.1f, 4);
-  const FingertipId tip =
-      block.world.addFingertip(Vec3(0.0f, 0.2f, 0.0f), 0.03f, 0.0f, FingertipContactMode::Triangles);
-  for (int step = 0; step < 60; ++step) block.world.step();                // settle first
-  block.world.moveFingertip(tip, Vec3(0.0f, 0.1f + 0.03f - 0.01f, 0.0f));  // 1 cm into the top face
-  for (int step = 0; step < 300; ++step) block.world.step();
-  const Vec3 push = block.world.fingertipForce(tip);
-  ASSERT_GT(block.world.fingertipContactCount(tip), 0u);
-  ASSERT_GT(-push.y(), 0.1f * block.weight);  // a real push, not noise
-  EXPECT_NEAR(-push.y(), block.groundReaction() - block.weight, 1e-3f * block.groundReaction());
-  // The per-particle readout includes the triangle contacts: the net constraint force is the weight.
-  Vec3 total = Vec3::Zero();
-  for (const Vec3& f : block.world.particleConstraintForces(block.body)) total += f;
-  EXPECT_NEAR(total.y(), block.weight, 1e-3f * block.groundReaction());
 }
 
 TEST(FingertipTriangles, DisabledFingertipMakesNoContacts) {

@@ -309,22 +309,7 @@ TEST(SessionRecording, ArbitraryInputParsesOrThrowsError) {
       ++rejected;
     }
   };
-  for (int i = 0; i < 3000; ++i) {
-    std::string text = valid;
-    const std::size_t at = rng() % text.size();
-    switch (rng() % 3) {
-      case 0:
-        text[at] = static_cast<char>(rng());
-        break;
-      case 1:
-        text.insert(at, 1, alphabet[rng() % alphabet.size()]);
-        break;
-      default:
-        text.erase(at, 1 + rng() % 8);
-        break;
-    }
-    attempt(text);
-  }
+  for (int i = 0; i < 3000; ++i) attempt(testing::mutate(valid, rng, alphabet));
   for (int i = 0; i < 2000; ++i) {
     std::string text = i % 3 == 0 ? "vrdeform-session 1\n" : "";
     const std::size_t n = rng() % 300;

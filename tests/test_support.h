@@ -5,6 +5,7 @@
 
 #include <sstream>
 #include <string>
+#include <string_view>
 
 #include "vrdeform/error.h"
 
@@ -32,6 +33,26 @@ std::string errorOf(F&& f) {
   }
   ADD_FAILURE() << "no vrd::Error thrown";
   return {};
+}
+
+/// A random edit of `text` for fuzzing a parser: one byte replaced by a random one, one character
+/// of `alphabet` inserted, or 1-8 bytes erased.
+template <typename Rng>
+std::string mutate(std::string text, Rng& rng, std::string_view alphabet) {
+  if (text.empty()) return text;
+  const std::size_t at = rng() % text.size();
+  switch (rng() % 3) {
+    case 0:
+      text[at] = static_cast<char>(rng());
+      break;
+    case 1:
+      text.insert(at, 1, alphabet[rng() % alphabet.size()]);
+      break;
+    default:
+      text.erase(at, 1 + rng() % 8);
+      break;
+  }
+  return text;
 }
 
 }  // namespace vrd::testing
