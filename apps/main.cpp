@@ -4,6 +4,7 @@
 
 #include "demo.h"
 #include "mesh_commands.h"
+#include "touch_command.h"
 #include "vrdeform/error.h"
 
 int main(int argc, char** argv) {
@@ -33,11 +34,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
 
   const auto runMeshCommand = vrd::addMeshCommands(app);
+  const auto runTouchCommand = vrd::addTouchCommand(app);
 
   CLI11_PARSE(app, argc, argv);
   try {
     if (*run) return vrd::runDemo(demo);
     if (app.got_subcommand("mesh")) return runMeshCommand();
+    if (app.got_subcommand("touch")) return runTouchCommand();
   } catch (const vrd::Error& e) {
     fmt::print(stderr, "vrdeform: {}\n", e.what());
     return 2;
