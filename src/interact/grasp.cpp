@@ -81,8 +81,6 @@ void Grasp::update(World& world, const HandRig& rig) {
     if (any) {
       pinching[int(Finger::Thumb)] = true;
       begin(world, rig, *body, pinching);
-      lastAperture_ = aperture;
-      return;
     }
   }
   lastAperture_ = aperture;
