@@ -10,10 +10,13 @@ packages=(
   libfmt-dev          # formatting of reports
   libassimp-dev       # surface mesh import
   libpugixml-dev zlib1g-dev   # VTK XML tet meshes
+  nlohmann-json3-dev  # WEART middleware JSON messages
+  liblo-dev           # OSC output for other haptic devices and tools
   tetgen              # optional mesher, run as a separate program (AGPL)
   libgtest-dev libgmock-dev googletest   # unit tests
   libbenchmark-dev    # benchmarks
   clang-format        # code style check
+  clang libclang-rt-14-dev   # libFuzzer for the fuzz targets (fuzz/)
 )
 
 missing=()
