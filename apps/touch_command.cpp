@@ -18,9 +18,15 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <utility>
 #include <vector>
 
+#include "vrdeform/devices/csv_recorder.h"
+#include "vrdeform/devices/glove_input.h"
+#include "vrdeform/devices/osc_output.h"
+#include "vrdeform/devices/stop_signals.h"
+#include "vrdeform/devices/weart_client.h"
 #include "vrdeform/error.h"
 #include "vrdeform/haptics/calibration.h"
 #include "vrdeform/haptics/haptic_session.h"
@@ -61,7 +67,7 @@ struct Scene {
 struct TouchArgs {
   Scene scene;
   bool noCalibrate = false;
-  std::string script, csv, record, replay;
+  std::string script, csv, record, replay, weart, osc, forces;
   double seconds = 0.0;  // 0: no cap
   double reportEvery = 0.25;
 };
@@ -365,6 +371,17 @@ class StandardPoke final : public HandInput {
   float radius_;
 };
 
+// A palm-down wrist over `top`: an open hand is clear of it, and closing the index lowers its
+// fingertip onto it (it reaches lowest near closure 0.5, pressing half a fingertip radius deep).
+Eigen::Isometry3f wristAbove(const Vec3& top, const HandGeometry& hand) {
+  HandPose pose;
+  pose.wrist.linear() = Eigen::AngleAxisf(1.5707963f, Vec3::UnitX()).toRotationMatrix();  // +z (palm) down
+  pose.closure.fill(0.5f);
+  const Vec3 reach = fingertipPosition(hand, pose, Finger::Index);  // wrist at the origin
+  pose.wrist.translation() = top + Vec3(0.0f, 0.5f * hand.fingertipRadius, 0.0f) - reach;
+  return pose.wrist;
+}
+
 // --- Output --------------------------------------------------------------------------------------
 
 // Writes `text` to a temporary beside `path` and renames it into place: complete or not at all.
@@ -532,9 +549,25 @@ int touch(const TouchArgs& a, const std::string& version) {
   settings = sessionSettings(s, tau);
 
   std::optional<StandardPoke> poke;
+  std::optional<weart::Client> glove;
+  std::optional<weart::GloveInput> gloveInput;
   HandInput* input = nullptr;
   std::string inputName;
-  if (script) {
+  if (!a.weart.empty()) {
+    // The glove tracks fingers, not the hand: the wrist is held palm down over the body's top, so
+    // that closing the hand brings the fingertips onto it.
+    weart::ClientSettings cs = weart::parseEndpoint(a.weart);
+    cs.thimbles.clear();
+    for (int f = 0; f < kFingerCount; ++f)
+      if (settings.hand.fingers[f]) cs.thimbles.push_back(weart::pointOf(Finger(f)));
+    glove.emplace(cs);
+    glove->start();
+    gloveInput.emplace(*glove, wristAbove(body.top, settings.hand.geometry));
+    input = &*gloveInput;
+    inputName = fmt::format("glove {}:{}", cs.host, cs.port);
+    fmt::print("input: WEART glove via the middleware at {}:{} (Ctrl-C stops; the glove is released)\n", cs.host,
+               cs.port);
+  } else if (script) {
     input = &*script;
     std::error_code ignored;
     inputName = fmt::format("script {}", fs::absolute(a.script, ignored).lexically_normal().string());
@@ -558,10 +591,34 @@ int touch(const TouchArgs& a, const std::string& version) {
   }
 
   HapticSession session(*body.world, settings, input->frame(0, 0.0));
+  // Other outputs of the same signal: a timestamped force log and OSC over UDP (docs/outputs.md).
+  std::vector<std::unique_ptr<HapticOutput>> outputs;
+  if (!a.forces.empty()) outputs.push_back(std::make_unique<CsvRecorder>(a.forces, settings.hand.fingers));
+  if (!a.osc.empty()) {
+    const HostPort to = parseHostPort(a.osc);
+    outputs.push_back(std::make_unique<OscOutput>(to.host, to.port));
+  }
   std::string csv;
-  const Tally tally =
-      drive(session, *input, stepCap(a.seconds, s.rate), a.reportEvery, recording ? &*recording : nullptr,
-            a.csv.empty() ? nullptr : &csv, [](std::uint64_t) { return true; });
+  const StopSignals signals;
+  const auto wallStart = std::chrono::steady_clock::now();
+  const auto afterStep = [&](std::uint64_t k) {
+    const HapticSample sample = sampleOf(double(k + 1) / s.rate, session.haptics(), settings.hand.fingers);
+    for (const auto& out : outputs) out->send(sample);
+    if (!glove) return !signals.requested();
+    // The glove runs in real time: publish this step's forces, then wait for the step's wall time.
+    std::array<float, kFingerCount> force{};
+    for (int f = 0; f < kFingerCount; ++f) force[f] = session.haptics().fingers[f].force;
+    glove->publishForces(force);
+    for (const weart::Event& e : glove->takeEvents()) fmt::print(e.error ? stderr : stdout, "glove: {}\n", e.message);
+    std::this_thread::sleep_until(wallStart + std::chrono::duration<double>(double(k + 1) / s.rate));
+    return !signals.requested();
+  };
+  const std::uint64_t cap =
+      glove && a.seconds <= 0.0 ? std::numeric_limits<std::uint64_t>::max() : stepCap(a.seconds, s.rate);
+  const Tally tally = drive(session, *input, cap, a.reportEvery, recording ? &*recording : nullptr,
+                            a.csv.empty() ? nullptr : &csv, afterStep);
+  if (glove) glove->shutdown();  // release the glove before anything that could throw below
+  for (const auto& out : outputs) out->release();
   printSummary(tally, session.rig(), 1.0 / s.rate);
   if (!a.csv.empty()) {
     writeWhole(a.csv, csv);
@@ -575,8 +632,8 @@ int touch(const TouchArgs& a, const std::string& version) {
 }
 
 int replay(const TouchArgs& a, const std::string& version, bool sceneOptionsGiven) {
-  if (!a.record.empty() || !a.script.empty())
-    throw Error("touch: --replay cannot be combined with --record or --script");
+  if (!a.record.empty() || !a.script.empty() || !a.weart.empty() || !a.osc.empty() || !a.forces.empty())
+    throw Error("touch: --replay cannot be combined with --record, --script, --weart, --osc or --forces");
   if (sceneOptionsGiven)
     fmt::print(stderr,
                "note: --replay rebuilds the scene from the recording's settings; MESH and scene options "
@@ -716,6 +773,11 @@ std::function<int()> addTouchCommand(CLI::App& app) {
       cmd->add_option("--seconds", args->seconds, "Stop after this much simulated time (default: when the input ends)");
   cmd->add_option("--report-every", args->reportEvery, "Seconds between timeline rows")->capture_default_str();
   cmd->add_option("--csv", args->csv, "Write every step's outputs to this CSV file");
+  cmd->add_option("--forces", args->forces, "Log every step's per-finger forces with timestamps to this CSV file");
+  cmd->add_option("--osc", args->osc, "Send every step's forces as OSC over UDP to HOST:PORT (docs/outputs.md)");
+  cmd->add_option("--weart", args->weart,
+                  "Drive the hand from a WEART glove and send it the forces: the middleware's HOST:PORT "
+                  "(default port 13031)");
   cmd->add_option("--record", args->record, "Save the session (settings, hand and outputs per step)");
   cmd->add_option("--replay", args->replay,
                   "Rebuild the scene of a recording, replay its hand and check the outputs bit for bit");

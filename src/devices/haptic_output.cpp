@@ -1,0 +1,36 @@
+#include "vrdeform/devices/haptic_output.h"
+
+namespace vrd {
+
+HapticSample sanitised(const HapticSample& sample) {
+  HapticSample out;
+  out.time = std::isfinite(sample.time) ? sample.time : 0.0;
+  out.paper = clampUnit(sample.paper);
+  out.present = sample.present;
+  for (int f = 0; f < kFingerCount; ++f) {
+    if (!sample.present[f]) continue;
+    out.force[f] = clampUnit(sample.force[f]);
+    out.newtons[f] = clampNewtons(sample.newtons[f]);
+  }
+  return out;
+}
+
+HapticSample sampleOf(double time, const HapticFrame& frame, const std::array<bool, kFingerCount>& present) {
+  HapticSample sample;
+  sample.time = time;
+  sample.paper = frame.paper;
+  sample.present = present;
+  for (int f = 0; f < kFingerCount; ++f) {
+    sample.force[f] = frame.fingers[f].force;
+    sample.newtons[f] = frame.fingers[f].newtons;
+  }
+  return sanitised(sample);
+}
+
+std::string_view fingerName(Finger finger) {
+  static constexpr std::array<std::string_view, kFingerCount> kNames{"thumb", "index", "middle", "ring", "little"};
+  const int i = static_cast<int>(finger);
+  return i >= 0 && i < kFingerCount ? kNames[i] : std::string_view("finger?");
+}
+
+}  // namespace vrd
