@@ -1,5 +1,7 @@
 #include "vrdeform/devices/csv_recorder.h"
 
+#include "posix_fd.h"
+
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <unistd.h>
@@ -31,8 +33,6 @@ void appendMilliseconds(std::string& out, std::chrono::steady_clock::duration d)
   const auto result = std::to_chars(text, text + sizeof text, ms, std::chars_format::fixed, 3);
   out.append(text, result.ptr);
 }
-
-std::string errnoText(int code) { return std::error_code(code, std::generic_category()).message(); }
 
 }  // namespace
 

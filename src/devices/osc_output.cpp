@@ -1,5 +1,7 @@
 #include "vrdeform/devices/osc_output.h"
 
+#include "posix_fd.h"
+
 #include <fmt/format.h>
 #include <lo/lo.h>
 #include <netdb.h>
@@ -22,8 +24,6 @@
 namespace vrd {
 
 namespace {
-
-std::string errnoText(int code) { return std::error_code(code, std::generic_category()).message(); }
 
 /// Host names, IPv4 and IPv6 literals (with a %scope): checked before any name lookup, so that a
 /// typo fails at once instead of after a DNS timeout.

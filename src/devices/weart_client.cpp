@@ -1,5 +1,7 @@
 #include "vrdeform/devices/weart_client.h"
 
+#include "posix_fd.h"
+
 #include <fcntl.h>
 #include <netdb.h>
 #include <netinet/in.h>
@@ -43,13 +45,6 @@ std::uint64_t unixMs() {
       std::chrono::duration_cast<milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
 }
 
-std::string errnoText(int err) { return std::strerror(err); }
-
-int pollMs(Clock::duration d) {
-  const auto ms = std::chrono::ceil<milliseconds>(d).count();
-  return int(std::clamp<long long>(ms, 0, 60'000));
-}
-
 bool validPort(std::string_view text, std::uint16_t& port) {
   if (text.empty() || text.size() > 5) return false;
   unsigned value = 0;
@@ -78,28 +73,6 @@ bool validIpv6(std::string_view host) {
   if (zone == std::string_view::npos) return true;
   return validHostName(host.substr(zone + 1));
 }
-
-// A file descriptor that closes itself.
-class Fd {
- public:
-  Fd() = default;
-  explicit Fd(int fd) : fd_(fd) {}
-  Fd(Fd&& o) noexcept : fd_(std::exchange(o.fd_, -1)) {}
-  Fd& operator=(Fd&& o) noexcept {
-    if (this != &o) reset(std::exchange(o.fd_, -1));
-    return *this;
-  }
-  ~Fd() { reset(); }
-  int get() const { return fd_; }
-  explicit operator bool() const { return fd_ >= 0; }
-  void reset(int fd = -1) {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = fd;
-  }
-
- private:
-  int fd_ = -1;
-};
 
 // Wakes the I/O thread out of poll() (shutdown).
 class WakePipe {
