@@ -1,5 +1,6 @@
 #include "vrdeform/devices/osc_output.h"
 
+#include "endpoint.h"
 #include "posix_fd.h"
 
 #include <fmt/format.h>
@@ -12,7 +13,6 @@
 #include <array>
 #include <cctype>
 #include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -24,16 +24,6 @@
 namespace vrd {
 
 namespace {
-
-/// Host names, IPv4 and IPv6 literals (with a %scope): checked before any name lookup, so that a
-/// typo fails at once instead of after a DNS timeout.
-bool plausibleHost(std::string_view host) {
-  if (host.empty() || host.size() > 253) return false;
-  for (const char c : host)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-' && c != '_' && c != ':' && c != '%')
-      return false;
-  return true;
-}
 
 /// "" or "/name[/name...]" with printable characters that OSC does not reserve for patterns.
 bool validPrefix(std::string_view prefix) {
@@ -68,33 +58,17 @@ struct AddrInfoDeleter {
 }  // namespace
 
 HostPort parseHostPort(std::string_view text) {
-  std::string_view host, port;
-  if (!text.empty() && text.front() == '[') {
-    const std::size_t close = text.find(']');
-    if (close == std::string_view::npos || close + 1 >= text.size() || text[close + 1] != ':')
-      throw Error(fmt::format("\"{}\": expected [IPv6 address]:port", text));
-    host = text.substr(1, close - 1);
-    port = text.substr(close + 2);
-  } else {
-    const std::size_t colon = text.rfind(':');
-    if (colon == std::string_view::npos) throw Error(fmt::format("\"{}\": expected host:port", text));
-    host = text.substr(0, colon);
-    port = text.substr(colon + 1);
-    if (host.find(':') != std::string_view::npos)
-      throw Error(fmt::format("\"{}\": write an IPv6 address in brackets, [address]:port", text));
-  }
-  if (host.empty()) throw Error(fmt::format("\"{}\": no host before the port", text));
-  int value = 0;
-  const auto [end, ec] = std::from_chars(port.data(), port.data() + port.size(), value);
-  if (port.empty() || ec != std::errc() || end != port.data() + port.size() || value < 1 || value > 65535)
-    throw Error(fmt::format("\"{}\": the port must be a number in 1..65535", text));
-  return {std::string(host), value};
+  std::string why;
+  const std::optional<Endpoint> e = splitEndpoint(text, why);
+  if (!e) throw Error(fmt::format("\"{}\": {} (expected HOST:PORT or [IPv6]:PORT)", text, why));
+  if (e->host.empty() || !e->port) throw Error(fmt::format("\"{}\": expected HOST:PORT or [IPv6]:PORT", text));
+  return {e->host, *e->port};
 }
 
 OscOutput::OscOutput(std::string_view host, int port, std::string_view prefix, const OscOptions& options)
     : prefix_(prefix), options_(options) {
   if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
-  if (!plausibleHost(host)) throw Error(fmt::format("OSC output: \"{}\" is not a host name or address", host));
+  if (!validHost(host)) throw Error(fmt::format("OSC output: \"{}\" is not a host name or address", host));
   if (port < 1 || port > 65535) throw Error(fmt::format("OSC output: port {} is not in 1..65535", port));
   if (!validPrefix(prefix))
     throw Error(

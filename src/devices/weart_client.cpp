@@ -1,5 +1,6 @@
 #include "vrdeform/devices/weart_client.h"
 
+#include "endpoint.h"
 #include "posix_fd.h"
 
 #include <fcntl.h>
@@ -13,7 +14,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <deque>
@@ -43,35 +43,6 @@ float force01(float v) { return std::isnan(v) ? 0.0f : std::clamp(v, 0.0f, 1.0f)
 std::uint64_t unixMs() {
   return std::uint64_t(
       std::chrono::duration_cast<milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
-}
-
-bool validPort(std::string_view text, std::uint16_t& port) {
-  if (text.empty() || text.size() > 5) return false;
-  unsigned value = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || end != text.data() + text.size() || value == 0 || value > 65535) return false;
-  port = std::uint16_t(value);
-  return true;
-}
-
-bool validHostName(std::string_view host) {
-  if (host.empty() || host.size() > 253) return false;
-  return std::all_of(host.begin(), host.end(), [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' || c == '-' ||
-           c == '_';
-  });
-}
-
-bool validIpv6(std::string_view host) {
-  if (host.size() < 2 || host.find(':') == std::string_view::npos) return false;
-  const std::size_t zone = host.find('%');
-  const std::string_view address = host.substr(0, zone);
-  const bool addressOk = std::all_of(address.begin(), address.end(), [](char c) {
-    return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F') || c == ':' || c == '.';
-  });
-  if (!addressOk) return false;
-  if (zone == std::string_view::npos) return true;
-  return validHostName(host.substr(zone + 1));
 }
 
 // Wakes the I/O thread out of poll() (shutdown).
@@ -107,38 +78,13 @@ enum class Ending { Stopping, PeerClosed, Failed, Exit };
 // --- free functions -----------------------------------------------------------------------------
 
 ClientSettings parseEndpoint(std::string_view endpoint, ClientSettings base) {
-  const std::string quoted = "'" + std::string(endpoint) + "'";
-  auto fail = [&](const std::string& why) -> Error {
-    return Error("WEART endpoint " + quoted + ": " + why + " (expected HOST:PORT, HOST, :PORT or [IPv6]:PORT)");
-  };
-  if (endpoint.empty()) throw fail("empty");
-  std::string_view host, port;
-  if (endpoint.front() == '[') {
-    const std::size_t close = endpoint.find(']');
-    if (close == std::string_view::npos) throw fail("no ']' after the IPv6 address");
-    host = endpoint.substr(1, close - 1);
-    const std::string_view rest = endpoint.substr(close + 1);
-    if (!rest.empty()) {
-      if (rest.front() != ':') throw fail("unexpected text after ']'");
-      port = rest.substr(1);
-      if (port.empty()) throw fail("empty port");
-    }
-    if (!validIpv6(host)) throw fail("not an IPv6 address inside [ ]");
-  } else if (std::count(endpoint.begin(), endpoint.end(), ':') > 1) {
-    host = endpoint;  // a bare IPv6 address, no port
-    if (!validIpv6(host)) throw fail("not a host name or an IPv6 address");
-  } else {
-    const std::size_t colon = endpoint.find(':');
-    host = endpoint.substr(0, colon);
-    if (colon != std::string_view::npos) {
-      port = endpoint.substr(colon + 1);
-      if (port.empty()) throw fail("empty port");
-    }
-    if (!host.empty() && !validHostName(host)) throw fail("bad host name");
-  }
-  if (host.empty() && port.empty()) throw fail("no host and no port");
-  if (!port.empty() && !validPort(port, base.port)) throw fail("the port must be a number from 1 to 65535");
-  if (!host.empty()) base.host = std::string(host);
+  std::string why;
+  const std::optional<Endpoint> e = splitEndpoint(endpoint, why);
+  if (!e)
+    throw Error("WEART endpoint '" + std::string(endpoint) + "': " + why +
+                " (expected HOST:PORT, HOST, :PORT or [IPv6]:PORT)");
+  if (!e->host.empty()) base.host = e->host;
+  if (e->port) base.port = *e->port;
   return base;
 }
 
