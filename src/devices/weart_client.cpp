@@ -38,8 +38,6 @@ constexpr std::size_t kMaxEvents = 256;
 constexpr std::size_t kMaxPending = 1 << 20;  // unsent bytes before the connection counts as stuck
 constexpr std::size_t kReadChunk = 16384;
 
-float force01(float v) { return std::isnan(v) ? 0.0f : std::clamp(v, 0.0f, 1.0f); }
-
 std::uint64_t unixMs() {
   return std::uint64_t(
       std::chrono::duration_cast<milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
@@ -761,7 +759,7 @@ void Client::publishForces(const std::array<float, kFingerCount>& force) {
   std::array<float, kPointCount> values{};
   for (int f = 0; f < kFingerCount; ++f) {
     const std::size_t p = std::size_t(pointOf(Finger(f)));
-    if (impl_->isThimble[p]) values[p] = force01(force[std::size_t(f)]);
+    if (impl_->isThimble[p]) values[p] = clampUnit(force[std::size_t(f)]);
   }
   const Clock::time_point now = Clock::now();
   std::lock_guard lock(impl_->desiredMutex);

@@ -4,23 +4,19 @@
 #include <cmath>
 
 namespace vrd {
-namespace {
 
-// clip(x, 0, 1) that also maps NaN to 0: a broken multiplier must not reach the glove.
-float unitClip(float x) { return x > 0.0f ? std::min(x, 1.0f) : 0.0f; }
-
-}  // namespace
+// clampUnit (math/types.h) maps NaN to 0 as well: a broken multiplier must not reach the glove.
 
 float normalisedContact(float lambdaSum, std::size_t contactCount, float tauContact) {
   if (contactCount == 0) return 0.0f;
-  return unitClip(std::abs(lambdaSum) / (float(contactCount) * tauContact));
+  return clampUnit(std::abs(lambdaSum) / (float(contactCount) * tauContact));
 }
 
 float tetSignal(float volumeLambda, const StrainLambda& strainLambda, const HapticSignalSettings& s) {
   float strainSq = 0.0f;
   for (float l : strainLambda) strainSq += l * l;
-  return s.betaVolume * unitClip(std::abs(volumeLambda) / s.tauVolume) +
-         s.betaStrain * unitClip(std::sqrt(strainSq) / s.tauStrain);
+  return s.betaVolume * clampUnit(std::abs(volumeLambda) / s.tauVolume) +
+         s.betaStrain * clampUnit(std::sqrt(strainSq) / s.tauStrain);
 }
 
 float volumeStrainSignal(std::span<const Vec3> centroids, std::span<const float> tetSignals, const Vec3& graspCentre,
@@ -31,18 +27,18 @@ float volumeStrainSignal(std::span<const Vec3> centroids, std::span<const float>
     weighted += w * tetSignals[j];
     weights += w;
   }
-  return weights > 0.0 ? unitClip(float(weighted / weights)) : 0.0f;
+  return weights > 0.0 ? clampUnit(float(weighted / weights)) : 0.0f;
 }
 
 float rawHapticForce(bool grasping, std::size_t contactCount, float contactSignal, float volumeStrain,
                      const HapticSignalSettings& s) {
-  if (grasping) return unitClip(volumeStrain);
-  if (contactCount > 0) return unitClip(s.betaContact * contactSignal + (1.0f - s.betaContact) * volumeStrain);
+  if (grasping) return clampUnit(volumeStrain);
+  if (contactCount > 0) return clampUnit(s.betaContact * contactSignal + (1.0f - s.betaContact) * volumeStrain);
   return 0.0f;
 }
 
 float smoothHapticForce(float previous, float raw, float alphaT) {
-  return unitClip((1.0f - alphaT) * unitClip(previous) + alphaT * unitClip(raw));
+  return clampUnit((1.0f - alphaT) * clampUnit(previous) + alphaT * clampUnit(raw));
 }
 
 float limitChange(float previous, float next, float maxStep) {

@@ -22,12 +22,10 @@ struct HapticSample {
   std::array<bool, kFingerCount> present{};   ///< fingers the hand has (G1: thumb, index, middle)
 };
 
-/// A normalised value as outputs emit it: clamped to [0, 1], NaN reads as 0.
-inline float clampUnit(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; }  // NaN fails v > 0
 /// A force in newtons as outputs emit it: finite and >= 0 (a magnitude), anything else reads as 0.
 inline float clampNewtons(float v) { return std::isfinite(v) && v > 0.0f ? v : 0.0f; }
 
-/// The sample an output emits for `sample`: normalised values through clampUnit, newtons through
+/// The sample an output emits for `sample`: normalised values through clampUnit (math/types.h), newtons through
 /// clampNewtons, zeros for absent fingers, a non-finite time read as 0.
 HapticSample sanitised(const HapticSample& sample);
 

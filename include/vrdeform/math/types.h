@@ -22,6 +22,9 @@ using Quat = Eigen::Quaternionf;
 /// Particle and element indices.
 using Index = std::uint32_t;
 
+/// Clamps to [0, 1] with NaN read as 0: how every normalised haptic value leaves the engine.
+inline float clampUnit(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; }  // NaN fails v > 0
+
 inline bool isFinite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
 
 }  // namespace vrd
