@@ -31,10 +31,6 @@ float angleBetween(const Eigen::Matrix3f& a, const Eigen::Matrix3f& b) {
   return Eigen::AngleAxisf(a.transpose() * b).angle();
 }
 
-std::filesystem::path tempPath(const std::string& name) {
-  return std::filesystem::temp_directory_path() / ("vrdeform_" + std::to_string(::getpid()) + "_" + name);
-}
-
 bool sameBits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
 
 TEST(HandScript, SamplesAreTheKeyframesExactlyAtTheirTimes) {
@@ -187,7 +183,7 @@ TEST(HandScript, SaveAndLoadGiveBackIdenticalKeyframes) {
     k.closure[i % 5] = float(i % 2);  // the ends of the range
   }
   const HandScript script(keys);
-  const std::filesystem::path path = tempPath("round_trip.hand");
+  const std::filesystem::path path = testing::scratchPath("round_trip.hand");
   script.save(path);
   const HandScript loaded = HandScript::load(path);
   std::filesystem::remove(path);
@@ -203,7 +199,7 @@ TEST(HandScript, SaveAndLoadGiveBackIdenticalKeyframes) {
 }
 
 TEST(HandScript, LoadNamesAMissingFile) {
-  const std::filesystem::path path = tempPath("missing.hand");
+  const std::filesystem::path path = testing::scratchPath("missing.hand");
   EXPECT_NE(errorOf([&] { HandScript::load(path); }).find(path.string()), std::string::npos);
 }
 

@@ -53,25 +53,7 @@ HapticSample makeSample(double time, const std::array<bool, kFingerCount>& prese
 
 // --- files -------------------------------------------------------------------------------------
 
-class TempDir {
- public:
-  TempDir() {
-    static int counter = 0;
-    path_ = fs::temp_directory_path() /
-            ("vrdeform_outputs_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
+using testing::TempDir;
 
 std::string readFile(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);

@@ -335,10 +335,9 @@ TEST(HapticSession, RecordedSessionReplaysBitForBit) {
   }
   ASSERT_TRUE(felt);  // the hand did touch the body
 
-  const std::filesystem::path file = std::filesystem::temp_directory_path() / "vrdeform_replay_test.session";
+  const std::filesystem::path file = testing::scratchPath("replay.session");
   recording.save(file);
   RecordingInput replay(SessionRecording::load(file));
-  std::filesystem::remove(file);
   Liver liver;
   HapticSession session(liver.world, s, replay.frame(0, 0.0));
   SessionRecording again;

@@ -24,10 +24,6 @@ namespace {
 using testing::errorOf;
 using Limits = std::numeric_limits<float>;
 
-std::filesystem::path tempPath(const std::string& name) {
-  return std::filesystem::temp_directory_path() / ("vrdeform_" + std::to_string(::getpid()) + "_" + name);
-}
-
 std::uint32_t bits(float v) { return std::bit_cast<std::uint32_t>(v); }
 
 // Finite floats of every kind: zeros of both signs, subnormals, the extremes, and random bit patterns.
@@ -118,7 +114,7 @@ std::string join(const std::vector<std::string>& lines) {
 TEST(SessionRecording, SaveAndLoadAreBitExact) {
   std::mt19937 rng(17);
   const SessionRecording recording = randomRecording(rng, 300);
-  const std::filesystem::path path = tempPath("bits.session");
+  const std::filesystem::path path = testing::scratchPath("bits.session");
   recording.save(path);
   const SessionRecording loaded = SessionRecording::load(path);
   std::filesystem::remove(path);
@@ -179,7 +175,7 @@ TEST(SessionRecording, SettingsKeepTheirOrderAndAreFoundByKey) {
 }
 
 TEST(SessionRecording, SettingsThatWouldNotReadBackAreRefusedAndLeaveTheFileAlone) {
-  const std::filesystem::path path = tempPath("refused.session");
+  const std::filesystem::path path = testing::scratchPath("refused.session");
   SessionRecording good;
   good.settings = {{"scene", "jelly"}};
   good.save(path);
@@ -196,7 +192,7 @@ TEST(SessionRecording, SettingsThatWouldNotReadBackAreRefusedAndLeaveTheFileAlon
   EXPECT_EQ(SessionRecording::load(path).settings, good.settings);  // the earlier file, untouched
   std::filesystem::remove(path);
   // Nor is a half-written file left where the folder cannot be written.
-  const std::filesystem::path nowhere = tempPath("no_such_dir") / "x.session";
+  const std::filesystem::path nowhere = testing::scratchPath("no_such_dir") / "x.session";
   EXPECT_NE(errorOf([&] { good.save(nowhere); }).find("cannot write"), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(nowhere.parent_path()));
 }
@@ -255,7 +251,7 @@ TEST(SessionRecording, MalformedFilesNameTheLine) {
   EXPECT_NE(errorOf([&] { SessionRecording::parse(join(decimal), "r.session"); }).find("r.session:4: step 0, field 37"),
             std::string::npos);
   EXPECT_NE(errorOf([] { SessionRecording::parse("", "empty"); }).find("empty:1: empty file"), std::string::npos);
-  EXPECT_NE(errorOf([] { SessionRecording::load(tempPath("absent.session")); }).find("absent.session"),
+  EXPECT_NE(errorOf([] { SessionRecording::load(testing::scratchPath("absent.session")); }).find("absent.session"),
             std::string::npos);
 }
 

@@ -29,36 +29,8 @@ namespace vrd {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::TempDir;
 const fs::path kTetMeshes = fs::path(VRDEFORM_SHARED_DIR) / "data" / "meshes" / "tet";
-
-// A fresh folder under the system's temporary folder, removed with its contents afterwards.
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ =
-        fs::temp_directory_path() / ("vrdeform_tet_io_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-  std::vector<std::string> files() const {
-    std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(path_)) names.push_back(entry.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-
- private:
-  fs::path path_;
-};
 
 void writeBytes(const fs::path& path, std::string_view bytes) {
   // A new file rather than a truncated one: ext4 flushes a file rewritten after truncation when it is
