@@ -163,7 +163,7 @@ struct FakeMiddleware::Impl {
   const FakeMiddlewareSettings settings;
   Fd listener;
   std::uint16_t port = 0;
-  Fd wakeRead, wakeWrite;
+  WakePipe wakePipe;
   std::atomic<bool> stopping{false};
   std::atomic<bool> stopped{false};
   std::thread thread;
@@ -196,15 +196,7 @@ struct FakeMiddleware::Impl {
   Clock::time_point sessionStart{}, nextTick{};
   std::optional<Clock::time_point> calibrationDue;
 
-  void wake() const {
-    const char byte = 1;
-    [[maybe_unused]] const ssize_t n = ::write(wakeWrite.get(), &byte, 1);
-  }
-  void drainWake() const {
-    char buffer[64];
-    while (::read(wakeRead.get(), buffer, sizeof buffer) > 0) {
-    }
-  }
+  void wake() const { wakePipe.notify(); }
   void note(std::string_view text) const {
     if (settings.onNote) settings.onNote(text);
   }
@@ -262,9 +254,9 @@ void FakeMiddleware::Impl::run() noexcept {
   try {
     while (!stopping.load()) {
       if (!client) {
-        pollfd p[2] = {{listener.get(), POLLIN, 0}, {wakeRead.get(), POLLIN, 0}};
+        pollfd p[2] = {{listener.get(), POLLIN, 0}, {wakePipe.fd(), POLLIN, 0}};
         ::poll(p, 2, int(kIdlePoll.count()));
-        drainWake();
+        wakePipe.drain();
         hooks();  // nobody to act on: discards
         if (p[0].revents & POLLIN) accept();
         continue;
@@ -272,9 +264,9 @@ void FakeMiddleware::Impl::run() noexcept {
       Clock::time_point next = Clock::now() + kIdlePoll;
       if (streaming) next = std::min(next, nextTick);
       if (calibrationDue) next = std::min(next, *calibrationDue);
-      pollfd p[2] = {{client.get(), POLLIN, 0}, {wakeRead.get(), POLLIN, 0}};
+      pollfd p[2] = {{client.get(), POLLIN, 0}, {wakePipe.fd(), POLLIN, 0}};
       ::poll(p, 2, pollMs(next - Clock::now()));
-      drainWake();
+      wakePipe.drain();
       hooks();
       if (client && (p[0].revents & (POLLIN | POLLHUP | POLLERR))) readClient();
       if (client) tick();
@@ -544,11 +536,6 @@ void FakeMiddleware::Impl::tick() {
 
 FakeMiddleware::FakeMiddleware(FakeMiddlewareSettings settings) : impl_(std::make_unique<Impl>(std::move(settings))) {
   Impl& m = *impl_;
-  int fds[2];
-  if (::pipe2(fds, O_NONBLOCK | O_CLOEXEC) != 0)
-    throw Error(std::string("fake middleware: pipe: ") + std::strerror(errno));
-  m.wakeRead.reset(fds[0]);
-  m.wakeWrite.reset(fds[1]);
   m.listener.reset(::socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0));
   if (!m.listener) throw Error(std::string("fake middleware: socket: ") + std::strerror(errno));
   const int one = 1;

@@ -1,13 +1,17 @@
 #pragma once
 // Small POSIX helpers shared by the device threads (internal).
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <string>
 #include <system_error>
 #include <utility>
+
+#include "vrdeform/error.h"
 
 namespace vrd {
 
@@ -31,6 +35,32 @@ class Fd {
 
  private:
   int fd_ = -1;
+};
+
+/// A non-blocking pipe that wakes a device thread out of poll(): poll fd() for POLLIN, notify()
+/// from any thread, drain() once woken.
+class WakePipe {
+ public:
+  WakePipe() {
+    int fds[2];
+    if (::pipe2(fds, O_NONBLOCK | O_CLOEXEC) != 0)
+      throw Error("cannot create a pipe: " + std::error_code(errno, std::generic_category()).message());
+    read_.reset(fds[0]);
+    write_.reset(fds[1]);
+  }
+  int fd() const { return read_.get(); }
+  void notify() const {
+    const char byte = 1;
+    [[maybe_unused]] const ssize_t n = ::write(write_.get(), &byte, 1);  // full pipe: already woken
+  }
+  void drain() const {
+    char buffer[64];
+    while (::read(read_.get(), buffer, sizeof buffer) > 0) {
+    }
+  }
+
+ private:
+  Fd read_, write_;
 };
 
 /// A poll() timeout for a wait of `d`: whole milliseconds, rounded up, within [0, 60 s].

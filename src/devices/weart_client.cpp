@@ -43,31 +43,6 @@ std::uint64_t unixMs() {
       std::chrono::duration_cast<milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
 }
 
-// Wakes the I/O thread out of poll() (shutdown).
-class WakePipe {
- public:
-  WakePipe() {
-    int fds[2];
-    if (::pipe2(fds, O_NONBLOCK | O_CLOEXEC) != 0)
-      throw Error("weart client: cannot create a pipe: " + errnoText(errno));
-    read_.reset(fds[0]);
-    write_.reset(fds[1]);
-  }
-  int fd() const { return read_.get(); }
-  void notify() const {
-    const char byte = 1;
-    [[maybe_unused]] const ssize_t n = ::write(write_.get(), &byte, 1);  // full pipe: already woken
-  }
-  void drain() const {
-    char buffer[64];
-    while (::read(read_.get(), buffer, sizeof buffer) > 0) {
-    }
-  }
-
- private:
-  Fd read_, write_;
-};
-
 // Why a session ended.
 enum class Ending { Stopping, PeerClosed, Failed, Exit };
 
