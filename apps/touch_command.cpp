@@ -207,23 +207,6 @@ SolverSettings solverSettings(const Scene& s) {
   return settings;
 }
 
-// Drops vertices no tet uses (tet files may list some; a body cannot have them).
-std::size_t dropUnusedVertices(TetMesh& mesh) {
-  std::vector<Index> remap(mesh.vertices.size(), std::numeric_limits<Index>::max());
-  for (const Tet& t : mesh.tets)
-    for (Index v : t)
-      if (v < remap.size()) remap[v] = 0;
-  std::vector<Vec3> kept;
-  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
-    if (remap[v] == 0) remap[v] = Index(kept.size()), kept.push_back(mesh.vertices[v]);
-  const std::size_t dropped = mesh.vertices.size() - kept.size();
-  if (dropped == 0) return 0;
-  for (Tet& t : mesh.tets)
-    for (Index& v : t) v = remap[v];
-  mesh.vertices = std::move(kept);
-  return dropped;
-}
-
 // Reads the mesh (tetrahedralising a surface), scales it and puts its lowest point on y = 0 with
 // its bounding box centred over the origin; builds the world with the ground and settles it.
 Setup buildBody(const Scene& s, bool print) {
@@ -246,7 +229,7 @@ Setup buildBody(const Scene& s, bool print) {
   } else {
     mesh = readTetMesh(s.mesh);
     body.hash = meshHash(mesh.vertices, mesh.tets);
-    const std::size_t dropped = dropUnusedVertices(mesh);
+    const std::size_t dropped = removeUnusedVertices(mesh);
     for (Vec3& v : mesh.vertices) v *= s.scale;
     if (print) {
       fmt::print("mesh: {} x {}: {} tets, used as is\n", name, s.scale, mesh.tets.size());

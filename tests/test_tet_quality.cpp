@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_support.h"
+
 #include <cmath>
 #include <numbers>
 #include <numeric>
@@ -31,6 +33,20 @@ TriMesh boxSurface(float s) {
 
 std::size_t histogramTotal(const TetQuality& q) {
   return std::accumulate(q.dihedralHistogram.begin(), q.dihedralHistogram.end(), std::size_t{0});
+}
+
+TEST(TetMesh, RemoveUnusedVerticesKeepsTheOthersInOrder) {
+  TetMesh mesh;
+  mesh.vertices = {Vec3(9, 9, 9), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(8, 8, 8), Vec3(0, 1, 0), Vec3(0, 0, 1)};
+  mesh.tets = {{1, 2, 4, 5}};
+  EXPECT_EQ(removeUnusedVertices(mesh), 2u);
+  ASSERT_EQ(mesh.vertices.size(), 4u);
+  EXPECT_EQ(mesh.vertices[0], Vec3(0, 0, 0));
+  EXPECT_EQ(mesh.vertices[3], Vec3(0, 0, 1));
+  EXPECT_EQ(mesh.tets[0], (Tet{0, 1, 2, 3}));
+  EXPECT_EQ(removeUnusedVertices(mesh), 0u);  // nothing left to drop
+  mesh.tets[0][2] = 7;
+  EXPECT_NE(vrd::testing::errorOf([&] { removeUnusedVertices(mesh); }).find("vertex 7"), std::string::npos);
 }
 
 TEST(TetQuality, RegularTet) {

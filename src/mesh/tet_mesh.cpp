@@ -66,4 +66,24 @@ void validateTriMesh(const TriMesh& mesh) {
   }
 }
 
+std::size_t removeUnusedVertices(TetMesh& mesh) {
+  constexpr Index kUnused = ~Index{0};
+  std::vector<Index> remap(mesh.vertices.size(), kUnused);
+  for (std::size_t e = 0; e < mesh.tets.size(); ++e)
+    for (Index v : mesh.tets[e]) {
+      if (v >= remap.size())
+        throw Error(fmt::format("tet {} refers to vertex {}, but there are only {} vertices", e, v, remap.size()));
+      remap[v] = 0;
+    }
+  std::vector<Vec3> kept;
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+    if (remap[v] == 0) remap[v] = Index(kept.size()), kept.push_back(mesh.vertices[v]);
+  const std::size_t dropped = mesh.vertices.size() - kept.size();
+  if (dropped == 0) return 0;
+  for (Tet& t : mesh.tets)
+    for (Index& v : t) v = remap[v];
+  mesh.vertices = std::move(kept);
+  return dropped;
+}
+
 }  // namespace vrd

@@ -37,6 +37,11 @@ inline constexpr double kDegenerateShape = 1e-6;
 /// non-finite coordinate, an out-of-range or repeated index, or a degenerate or inverted tet.
 void validateTetMesh(const TetMesh& mesh);
 
+/// Drops the vertices no tet uses (tet files may list some; a body cannot have them), keeping the
+/// others in order, and renumbers the tets. Returns how many were dropped; throws vrd::Error for
+/// an index out of range.
+std::size_t removeUnusedVertices(TetMesh& mesh);
+
 /// Throws vrd::Error for an empty mesh, non-finite coordinates, bad indices or degenerate triangles.
 void validateTriMesh(const TriMesh& mesh);
 
