@@ -1,7 +1,6 @@
 #include "touch_command.h"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -12,7 +11,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -34,6 +32,7 @@
 #include "vrdeform/interact/session_recording.h"
 #include "vrdeform/io/surface_io.h"
 #include "vrdeform/io/tet_io.h"
+#include "vrdeform/io/write_file.h"
 #include "vrdeform/mesh/tetrahedralise.h"
 #include "vrdeform/sim/world.h"
 
@@ -367,29 +366,6 @@ Eigen::Isometry3f wristAbove(const Vec3& top, const HandGeometry& hand) {
 
 // --- Output --------------------------------------------------------------------------------------
 
-// Writes `text` to a temporary beside `path` and renames it into place: complete or not at all.
-void writeWhole(const fs::path& path, std::string_view text) {
-  fs::path temp = path;
-  temp += fmt::format(".partial-{}", ::getpid());
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (out) out.write(text.data(), std::streamsize(text.size()));
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      fs::remove(temp, ignored);
-      throw Error(fmt::format("{}: cannot write the file", path.string()));
-    }
-  }
-  std::error_code ec;
-  fs::rename(temp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(temp, ignored);
-    throw Error(fmt::format("{}: {}", path.string(), ec.message()));
-  }
-}
-
 std::string outputName(std::size_t j) {
   if (j == 0) return "paper";
   if (j == 1) return "paper raw";
@@ -604,7 +580,7 @@ int touch(const TouchArgs& a, const std::string& version) {
   for (const auto& out : outputs) out->release();
   printSummary(tally, session.rig(), 1.0 / s.rate);
   if (!a.csv.empty()) {
-    writeWhole(a.csv, csv);
+    writeFile(a.csv, csv);
     fmt::print("wrote {}\n", a.csv);
   }
   if (recording) {
@@ -696,7 +672,7 @@ int replay(const TouchArgs& a, const std::string& version, bool sceneOptionsGive
                             });
   printSummary(tally, session.rig(), 1.0 / s.rate);
   if (!a.csv.empty()) {
-    writeWhole(a.csv, csv);
+    writeFile(a.csv, csv);
     fmt::print("wrote {}\n", a.csv);
   }
   if (!difference.empty()) {

@@ -22,6 +22,7 @@
 #include "vrdeform/error.h"
 #include "vrdeform/io/tet_io.h"
 #include "vrdeform/io/vtu_sequence.h"
+#include "vrdeform/io/write_file.h"
 #include "vrdeform/mesh/boundary.h"
 #include "vrdeform/mesh/primitives.h"
 
@@ -717,6 +718,16 @@ TEST(VtuSequence, DisplacementIsPositionMinusRest) {
 }
 
 // ---- boundaryFaces
+
+TEST(WriteFile, WholeOrNothing) {
+  TempDir dir;
+  writeFile(dir / "a.txt", "first");
+  writeFile(dir / "a.txt", "second, longer");
+  std::ifstream in(dir / "a.txt");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "second, longer");
+  EXPECT_NE(testing::errorOf([&] { writeFile(dir / "no_dir" / "b.txt", "x"); }).find("b.txt"), std::string::npos);
+  EXPECT_EQ(dir.files(), std::vector<std::string>{"a.txt"});  // no temporary left behind
+}
 
 TEST(Boundary, SingleTetFacesPointOutward) {
   const TetMesh tet{{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}, {{0, 1, 2, 3}}};

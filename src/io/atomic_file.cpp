@@ -6,6 +6,7 @@
 #include <system_error>
 
 #include "vrdeform/error.h"
+#include "vrdeform/io/write_file.h"
 
 namespace vrd {
 
@@ -32,6 +33,12 @@ void AtomicFile::commit() {
   std::filesystem::rename(temp_, target_, error);
   if (error) throw Error(fmt::format("cannot write {}: {}", target_.string(), error.message()));
   committed_ = true;
+}
+
+void writeFile(const std::filesystem::path& path, std::string_view text) {
+  AtomicFile file(path);
+  file.stream().write(text.data(), std::streamsize(text.size()));
+  file.commit();
 }
 
 }  // namespace vrd
