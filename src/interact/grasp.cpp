@@ -56,8 +56,7 @@ Vec3 Grasp::pinchCentre(const HandRig& rig) const {
 }
 
 void Grasp::update(World& world, const HandRig& rig) {
-  std::array<float, kFingerCount> aperture;
-  aperture.fill(std::numeric_limits<float>::quiet_NaN());
+  std::array<float, kFingerCount> aperture = noApertures();
   if (rig.has(Finger::Thumb))
     for (int f = 1; f < kFingerCount; ++f)
       if (rig.has(Finger(f))) aperture[f] = (rig.target(Finger(f)) - rig.target(Finger::Thumb)).norm();
@@ -67,7 +66,7 @@ void Grasp::update(World& world, const HandRig& rig) {
       release(world, rig);
     else
       follow(world, rig);
-  } else if (settings_.enabled && haveLastAperture_ && rig.has(Finger::Thumb)) {
+  } else if (settings_.enabled && rig.has(Finger::Thumb)) {
     // Thumb and at least one other finger on the same body, closing (Algorithm 2, line 3).
     const std::optional<BodyId> body = touchedBody(world, rig.fingertip(Finger::Thumb));
     const float minClosing = settings_.closingSpeed * world.settings().timeStep;
@@ -84,7 +83,6 @@ void Grasp::update(World& world, const HandRig& rig) {
     }
   }
   lastAperture_ = aperture;
-  haveLastAperture_ = true;
 }
 
 void Grasp::begin(World& world, const HandRig& rig, BodyId body, const std::array<bool, kFingerCount>& pinching) {

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "vrdeform/interact/hand_rig.h"
@@ -67,8 +68,13 @@ class Grasp {
   std::array<bool, kFingerCount> pinching_{};
   Finger partner_ = Finger::Index;  ///< the finger whose gap to the thumb decides the release
   float startAperture_ = 0.0f;
-  std::array<float, kFingerCount> lastAperture_{};  ///< thumb-to-finger gaps of the previous update (NaN: none)
-  bool haveLastAperture_ = false;
+  /// Thumb-to-finger gaps of the previous update; NaN (none yet) compares false, so nothing closes.
+  std::array<float, kFingerCount> lastAperture_ = noApertures();
+  static std::array<float, kFingerCount> noApertures() {
+    std::array<float, kFingerCount> a;
+    a.fill(std::numeric_limits<float>::quiet_NaN());
+    return a;
+  }
 
   // Paper mode: x_ref (eq. 35) and the hand displacement so far.
   std::vector<Vec3> reference_;
