@@ -74,7 +74,12 @@ const HapticFrame& HapticModel::update(const World& world, const HandRig& rig, c
   const HapticSignalSettings& s = settings_.signal;
   const float maxStep = settings_.maxChangePerMs * world.settings().timeStep * 1e3f;
   const float radius = rig.settings().geometry.fingertipRadius;
-  gatherTets(world);
+  // F_VS is needed only while something touches or holds the body: gather the tets then, once.
+  bool gathered = false;
+  const auto volumeStrain = [&](const Vec3& centre) {
+    if (!gathered) gatherTets(world), gathered = true;
+    return inverseDistanceSignal(centre);
+  };
 
   std::size_t handContacts = 0;
   float handLambda = 0.0f;
@@ -98,7 +103,7 @@ const HapticFrame& HapticModel::update(const World& world, const HandRig& rig, c
     // Eq. 43 for this finger alone: its contacts (summed, not averaged: one set of size 1), its
     // position as the grasp centre.
     out.raw = rawHapticForce(holding, count, normalisedContact(lambdaSum, count > 0 ? 1 : 0, s.tauFingerContact),
-                             count > 0 || holding ? inverseDistanceSignal(centre) : 0.0f, s);
+                             count > 0 || holding ? volumeStrain(centre) : 0.0f, s);
     out.force = limitChange(out.force, smoothHapticForce(out.force, out.raw, s.alphaT), maxStep);
     out.contacts = count;
 
@@ -117,7 +122,7 @@ const HapticFrame& HapticModel::update(const World& world, const HandRig& rig, c
   // Algorithm 2 as written: one contact set for the whole hand, p_g the mean fingertip position.
   const bool grasping = grasp.active();
   frame_.paperRaw = rawHapticForce(grasping, handContacts, normalisedContact(handLambda, handContacts, s.tauContact),
-                                   handContacts > 0 || grasping ? inverseDistanceSignal(rig.meanFingertip()) : 0.0f, s);
+                                   handContacts > 0 || grasping ? volumeStrain(rig.meanFingertip()) : 0.0f, s);
   frame_.paper = limitChange(frame_.paper, smoothHapticForce(frame_.paper, frame_.paperRaw, s.alphaT), maxStep);
   return frame_;
 }
