@@ -107,6 +107,36 @@ int convert(const ConvertArgs& a) {
   return 0;
 }
 
+// `vrdeform mesh IN OUT`: whatever turns IN into OUT. A surface is checked, then tetrahedralised
+// (a tet format out) or converted; a tet mesh is measured, then converted. Any failure is one line
+// and exit 1.
+struct AutoArgs {
+  std::string input, output, mesher = "builtin";
+  std::size_t tets = 0;
+};
+
+int meshInOut(const AutoArgs& a) {
+  if (a.input.empty() || a.output.empty())
+    throw Error("mesh: give IN and OUT, or a command (check, tet, quality, convert, compare); see --help");
+  try {
+    if (isSurfaceFile(a.input) && !isSurfaceFile(a.output)) {
+      TetArgs tet;
+      tet.input = a.input, tet.output = a.output, tet.mesher = a.mesher, tet.tets = a.tets;
+      if (check({a.input}) != 0) throw Error(fmt::format("{}: not a closed, clean surface (see above)", a.input));
+      return tetrahedraliseCommand(tet);
+    }
+    if (isSurfaceFile(a.input)) {
+      if (check({a.input, true}) != 0) throw Error(fmt::format("{}: the surface has defects (see above)", a.input));
+    } else if (quality({a.input, ""}) != 0) {
+      throw Error(fmt::format("{}: the tet mesh has inverted, degenerate or invalid tets (see above)", a.input));
+    }
+    return convert({a.input, a.output});
+  } catch (const Error& e) {
+    fmt::print(stderr, "vrdeform: {}\n", e.what());
+    return 1;
+  }
+}
+
 struct CompareArgs {
   std::vector<std::string> inputs;
   std::vector<std::size_t> tets{1500};
@@ -148,7 +178,15 @@ int compare(const CompareArgs& a) {
 
 std::function<int()> addMeshCommands(CLI::App& app) {
   CLI::App* mesh = app.add_subcommand("mesh", "Check, tetrahedralise, measure and convert meshes");
-  mesh->require_subcommand(1);
+  mesh->require_subcommand(0, 1);
+  auto autoArgs = std::make_shared<AutoArgs>();
+  mesh->add_option("in", autoArgs->input, "Without a command: the mesh to read (surface or tet mesh)");
+  mesh->add_option("out", autoArgs->output,
+                   "Without a command: the mesh to write; a tet format from a surface tetrahedralises it");
+  mesh->add_option("--tets", autoArgs->tets, "IN OUT: target tet count")->check(CLI::Range(1, 100'000'000));
+  mesh->add_option("--mesher", autoArgs->mesher, "IN OUT: builtin or tetgen")
+      ->check(CLI::IsMember({"builtin", "tetgen"}))
+      ->capture_default_str();
 
   auto checkArgs = std::make_shared<CheckArgs>();
   CLI::App* checkCmd =
@@ -200,7 +238,7 @@ std::function<int()> addMeshCommands(CLI::App& app) {
     if (*qualityCmd) return quality(*qualityArgs);
     if (*convertCmd) return convert(*convertArgs);
     if (*compareCmd) return compare(*compareArgs);
-    return 2;
+    return meshInOut(*autoArgs);
   };
 }
 

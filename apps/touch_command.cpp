@@ -20,20 +20,20 @@
 #include <utility>
 #include <vector>
 
+#include "glove_link.h"
 #include "vrdeform/devices/csv_recorder.h"
-#include "vrdeform/devices/glove_input.h"
 #include "vrdeform/devices/osc_output.h"
 #include "vrdeform/devices/stop_signals.h"
-#include "vrdeform/devices/weart_client.h"
 #include "vrdeform/error.h"
 #include "vrdeform/haptics/calibration.h"
 #include "vrdeform/haptics/haptic_session.h"
+#include "vrdeform/interact/hand_actions.h"
 #include "vrdeform/interact/hand_script.h"
 #include "vrdeform/interact/session_recording.h"
 #include "vrdeform/io/surface_io.h"
 #include "vrdeform/io/tet_io.h"
 #include "vrdeform/io/write_file.h"
-#include "vrdeform/mesh/tetrahedralise.h"
+#include "vrdeform/scene/scene_builder.h"
 #include "vrdeform/sim/world.h"
 
 namespace vrd {
@@ -103,21 +103,6 @@ std::string hexFloat(float v) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%a", double(v));
   return buffer;
-}
-
-std::uint64_t fnv1a(std::uint64_t h, const void* data, std::size_t bytes) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
-  return h;
-}
-
-// A fingerprint of the mesh as read (before scaling), so a replay notices an edited file.
-template <typename Element>
-std::uint64_t meshHash(const std::vector<Vec3>& vertices, const std::vector<Element>& elements) {
-  std::uint64_t h = 0xcbf29ce484222325ull;
-  for (const Vec3& v : vertices) h = fnv1a(h, v.data(), 3 * sizeof(float));
-  for (const Element& e : elements) h = fnv1a(h, e.data(), sizeof(e));
-  return h;
 }
 
 struct Taus {
@@ -210,40 +195,14 @@ SolverSettings solverSettings(const Scene& s) {
 // its bounding box centred over the origin; builds the world with the ground and settles it.
 Setup buildBody(const Scene& s, bool print) {
   Setup body;
-  TetMesh mesh;
-  const std::string name = fs::path(s.mesh).filename().string();
-  if (isSurfaceFile(s.mesh)) {
-    TriMesh surface = readSurface(s.mesh);
-    body.hash = meshHash(surface.vertices, surface.triangles);
-    for (Vec3& v : surface.vertices) v *= s.scale;
-    TetrahedraliseOptions options;
-    options.targetTets = std::size_t(s.tets);
-    const auto start = std::chrono::steady_clock::now();
-    Tetrahedralisation result = tetrahedralise(surface, options);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    mesh = std::move(result.mesh);
-    if (print)
-      fmt::print("mesh: {} ({} triangles) x {}: {} tets from the built-in mesher in {:.2f} s\n", name,
-                 surface.triangles.size(), s.scale, mesh.tets.size(), seconds);
-  } else {
-    mesh = readTetMesh(s.mesh);
-    body.hash = meshHash(mesh.vertices, mesh.tets);
-    const std::size_t dropped = removeUnusedVertices(mesh);
-    for (Vec3& v : mesh.vertices) v *= s.scale;
-    if (print) {
-      fmt::print("mesh: {} x {}: {} tets, used as is\n", name, s.scale, mesh.tets.size());
-      if (dropped > 0) fmt::print("note: dropped {} vertices that no tet uses\n", dropped);
-    }
-  }
-  if (mesh.vertices.empty()) throw Error(fmt::format("{}: no vertices", s.mesh));
-  Vec3 lo = mesh.vertices.front(), hi = lo;
-  for (const Vec3& v : mesh.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-  if (!isFinite(lo) || !isFinite(hi)) throw Error(fmt::format("{}: coordinates overflow after --scale", s.mesh));
-  const Vec3 shift(-0.5f * (lo.x() + hi.x()), -lo.y(), -0.5f * (lo.z() + hi.z()));
-  for (Vec3& v : mesh.vertices) v += shift;
-  if (print)
-    fmt::print("placed: x [{:.4f}, {:.4f}] m, y [0, {:.4f}] m, z [{:.4f}, {:.4f}] m\n", lo.x() + shift.x(),
-               hi.x() + shift.x(), hi.y() + shift.y(), lo.z() + shift.z(), hi.z() + shift.z());
+  BodySpec spec;
+  spec.mesh = s.mesh;
+  spec.scale = s.scale;
+  spec.mesher.targetTets = std::size_t(s.tets);
+  PlacedMesh placed =
+      placeBodyMesh(spec, print ? SceneLog([](std::string_view line) { fmt::print("{}\n", line); }) : SceneLog());
+  body.hash = placed.hash;
+  TetMesh& mesh = placed.tets;
 
   Material material;
   material.elastic = ElasticModuli{s.youngs, s.poisson, s.density, s.damping};
@@ -266,17 +225,7 @@ Setup buildBody(const Scene& s, bool print) {
     low = low.cwiseMin(p.pos), high = high.cwiseMax(p.pos);
     if (p.w > 0.0f) mass += 1.0 / p.w;
   }
-  // The top: the highest particle; among those within 1% of the height of it (a flat top), the one
-  // nearest the vertical through the middle of the body, so that a cube is poked in its middle.
-  const float nearTop = high.y() - 0.01f * (high.y() - low.y());
-  const Vec3 middle = 0.5f * (low + high);
-  float best = std::numeric_limits<float>::infinity();
-  body.top = Vec3::Constant(std::numeric_limits<float>::quiet_NaN());
-  for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
-    const Vec3& p = w.particles().x[i].pos;
-    const float off = Vec3(p.x() - middle.x(), 0.0f, p.z() - middle.z()).squaredNorm();
-    if (p.y() >= nearTop && off < best) best = off, body.top = p;
-  }
+  body.top = topPoint(w, body.id);
   if (!isFinite(body.top)) throw Error(fmt::format("{}: the body did not settle to finite positions", s.mesh));
   if (print) {
     fmt::print(
@@ -330,38 +279,14 @@ void printTaus(const Taus& tau, const Scene& s, std::string_view how) {
 
 // --- Inputs --------------------------------------------------------------------------------------
 
-// The built-in poke: the index fingertip (a direct frame) comes down on `top` to one fingertip radius
-// deep, holds and withdraws; the other fingertips wait 1 m above.
-class StandardPoke final : public HandInput {
- public:
-  StandardPoke(const Vec3& top, float radius) : top_(top), radius_(radius) {}
-  HandFrame frame(std::uint64_t, double t) override {
-    HandFrame f;
-    f.direct = true;
-    for (int i = 0; i < kFingerCount; ++i) f.fingertips[i] = top_ + Vec3(0.05f * float(i - 1), 1.0f, 0.0f);
-    const double r = radius_;
-    double depth = r;  // of the fingertip's lowest point below the top
-    if (!(t >= kPokeDown + kPokeHold)) depth = -r + 2.0 * r * std::clamp(t / kPokeDown, 0.0, 1.0);
-    if (t > kPokeDown + kPokeHold) depth = r - 2.0 * r * std::min(1.0, (t - kPokeDown - kPokeHold) / kPokeUp);
-    f.fingertips[int(Finger::Index)] = top_ + Vec3(0.0f, float(r - depth), 0.0f);
-    return f;
-  }
-  bool finished(std::uint64_t, double t) const override { return !(t <= kPokeDown + kPokeHold + kPokeUp); }
-
- private:
-  Vec3 top_;
-  float radius_;
-};
-
-// A palm-down wrist over `top`: an open hand is clear of it, and closing the index lowers its
-// fingertip onto it (it reaches lowest near closure 0.5, pressing half a fingertip radius deep).
-Eigen::Isometry3f wristAbove(const Vec3& top, const HandGeometry& hand) {
-  HandPose pose;
-  pose.wrist.linear() = Eigen::AngleAxisf(1.5707963f, Vec3::UnitX()).toRotationMatrix();  // +z (palm) down
-  pose.closure.fill(0.5f);
-  const Vec3 reach = fingertipPosition(hand, pose, Finger::Index);  // wrist at the origin
-  pose.wrist.translation() = top + Vec3(0.0f, 0.5f * hand.fingertipRadius, 0.0f) - reach;
-  return pose.wrist;
+// The built-in poke: the index fingertip comes down on `top` to one fingertip radius deep, holds
+// and withdraws.
+HandAction standardPoke(const Vec3& top, float radius) {
+  HandAction poke;
+  poke.target = top;
+  poke.approach = kPokeDown, poke.hold = kPokeHold, poke.release = kPokeUp;
+  poke.depth = radius;
+  return poke;
 }
 
 // --- Output --------------------------------------------------------------------------------------
@@ -507,25 +432,14 @@ int touch(const TouchArgs& a, const std::string& version) {
   }
   settings = sessionSettings(s, tau);
 
-  std::optional<StandardPoke> poke;
-  std::optional<weart::Client> glove;
-  std::optional<weart::GloveInput> gloveInput;
+  std::optional<HandActionsInput> poke;
+  std::optional<GloveLink> glove;
   HandInput* input = nullptr;
   std::string inputName;
   if (!a.weart.empty()) {
-    // The glove tracks fingers, not the hand: the wrist is held palm down over the body's top, so
-    // that closing the hand brings the fingertips onto it.
-    weart::ClientSettings cs = weart::parseEndpoint(a.weart);
-    cs.thimbles.clear();
-    for (int f = 0; f < kFingerCount; ++f)
-      if (settings.hand.fingers[f]) cs.thimbles.push_back(weart::pointOf(Finger(f)));
-    glove.emplace(cs);
-    glove->start();
-    gloveInput.emplace(*glove, wristAbove(body.top, settings.hand.geometry));
-    input = &*gloveInput;
-    inputName = fmt::format("glove {}:{}", cs.host, cs.port);
-    fmt::print("input: WEART glove via the middleware at {}:{} (Ctrl-C stops; the glove is released)\n", cs.host,
-               cs.port);
+    glove.emplace(a.weart, settings.hand, body.top);
+    input = &glove->input();
+    inputName = glove->name();
   } else if (script) {
     input = &*script;
     std::error_code ignored;
@@ -533,7 +447,8 @@ int touch(const TouchArgs& a, const std::string& version) {
     fmt::print("input: hand script {} ({} keyframes, {:g} s)\n", a.script, script->script().keyframes().size(),
                script->script().duration());
   } else {
-    poke.emplace(body.top, settings.hand.geometry.fingertipRadius);
+    poke.emplace(std::vector{standardPoke(body.top, settings.hand.geometry.fingertipRadius)},
+                 settings.hand.geometry.fingertipRadius);
     input = &*poke;
     inputName = "standard poke";
     fmt::print(
@@ -559,17 +474,10 @@ int touch(const TouchArgs& a, const std::string& version) {
   }
   std::string csv;
   const StopSignals signals;
-  const auto wallStart = std::chrono::steady_clock::now();
   const auto afterStep = [&](std::uint64_t k) {
     const HapticSample sample = sampleOf(double(k + 1) / s.rate, session.haptics(), settings.hand.fingers);
     for (const auto& out : outputs) out->send(sample);
-    if (!glove) return !signals.requested();
-    // The glove runs in real time: publish this step's forces, then wait for the step's wall time.
-    std::array<float, kFingerCount> force{};
-    for (int f = 0; f < kFingerCount; ++f) force[f] = session.haptics().fingers[f].force;
-    glove->publishForces(force);
-    for (const weart::Event& e : glove->takeEvents()) fmt::print(e.error ? stderr : stdout, "glove: {}\n", e.message);
-    std::this_thread::sleep_until(wallStart + std::chrono::duration<double>(double(k + 1) / s.rate));
+    if (glove) glove->afterStep(session.haptics(), double(k + 1) / s.rate);  // real time
     return !signals.requested();
   };
   const std::uint64_t cap =

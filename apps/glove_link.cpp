@@ -1,0 +1,51 @@
+#include "glove_link.h"
+
+#include <fmt/format.h>
+
+#include <thread>
+
+namespace vrd {
+namespace {
+
+weart::ClientSettings clientSettings(const std::string& endpoint, const HandRigSettings& hand) {
+  weart::ClientSettings cs = weart::parseEndpoint(endpoint);
+  cs.thimbles.clear();
+  for (int f = 0; f < kFingerCount; ++f)
+    if (hand.fingers[f]) cs.thimbles.push_back(weart::pointOf(Finger(f)));
+  return cs;
+}
+
+}  // namespace
+
+Eigen::Isometry3f wristAbove(const Vec3& point, const HandGeometry& hand) {
+  HandPose pose;
+  pose.wrist.linear() = Eigen::AngleAxisf(1.5707963f, Vec3::UnitX()).toRotationMatrix();  // +z (palm) down
+  pose.closure.fill(0.5f);
+  const Vec3 reach = fingertipPosition(hand, pose, Finger::Index);  // wrist at the origin
+  pose.wrist.translation() = point + Vec3(0.0f, 0.5f * hand.fingertipRadius, 0.0f) - reach;
+  return pose.wrist;
+}
+
+GloveLink::GloveLink(const std::string& endpoint, const HandRigSettings& hand, const Vec3& point)
+    : client_(clientSettings(endpoint, hand)) {
+  const weart::ClientSettings& cs = client_.settings();
+  client_.start();
+  input_.emplace(client_, wristAbove(point, hand.geometry));
+  name_ = fmt::format("glove {}:{}", cs.host, cs.port);
+  fmt::print("input: WEART glove via the middleware at {}:{} (Ctrl-C stops; the glove is released)\n", cs.host,
+             cs.port);
+}
+
+void GloveLink::afterStep(const HapticFrame& frame, double time) {
+  std::array<float, kFingerCount> force{};
+  for (int f = 0; f < kFingerCount; ++f) force[f] = frame.fingers[f].force;
+  client_.publishForces(force);
+  for (const weart::Event& e : client_.takeEvents()) fmt::print(e.error ? stderr : stdout, "glove: {}\n", e.message);
+  if (!start_)
+    start_ = std::chrono::steady_clock::now() -
+             std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(time));
+  std::this_thread::sleep_until(
+      *start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(time)));
+}
+
+}  // namespace vrd

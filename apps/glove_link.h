@@ -1,0 +1,43 @@
+#pragma once
+// A WEART glove as the hand of a command's simulation (`--weart HOST:PORT`): its finger closures
+// drive a palm-down hand held over a point of the body, each finger's force goes back to its
+// thimble, and the loop is paced to real time. The client's thread does the I/O, so a missing or
+// slow glove never stalls the simulation; every thimble is released at shutdown (and by the
+// client's watchdog, signals and destructor).
+
+#include <chrono>
+#include <optional>
+#include <string>
+
+#include "vrdeform/devices/glove_input.h"
+#include "vrdeform/devices/weart_client.h"
+#include "vrdeform/haptics/haptic_model.h"
+
+namespace vrd {
+
+class GloveLink {
+ public:
+  /// Connects in the background to `endpoint` (HOST[:PORT]) with a thimble per finger of `hand`;
+  /// the wrist is held palm down over `point`, so that closing the hand brings the fingertips onto it.
+  GloveLink(const std::string& endpoint, const HandRigSettings& hand, const Vec3& point);
+
+  HandInput& input() { return *input_; }
+  const std::string& name() const { return name_; }
+  /// After the step that ends at simulation time `time`: publishes the forces, prints the client's
+  /// news and sleeps until that time has passed on the wall clock (from the first call).
+  void afterStep(const HapticFrame& frame, double time);
+  /// Releases the glove and stops the client (also done by the destructor).
+  void shutdown() { client_.shutdown(); }
+
+ private:
+  weart::Client client_;
+  std::optional<weart::GloveInput> input_;
+  std::string name_;
+  std::optional<std::chrono::steady_clock::time_point> start_;
+};
+
+/// A palm-down wrist over `point`: an open hand is clear of it, and closing the index lowers its
+/// fingertip onto it (it reaches lowest near closure 0.5, pressing half a fingertip radius deep).
+Eigen::Isometry3f wristAbove(const Vec3& point, const HandGeometry& hand);
+
+}  // namespace vrd

@@ -1,0 +1,254 @@
+#include "run_command.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "glove_link.h"
+#include "vrdeform/devices/csv_recorder.h"
+#include "vrdeform/devices/osc_output.h"
+#include "vrdeform/devices/stop_signals.h"
+#include "vrdeform/error.h"
+#include "vrdeform/scene/scene_library.h"
+#include "vrdeform/scene/scene_run.h"
+
+namespace vrd {
+namespace {
+
+struct RunArgs {
+  std::string scene, out, weart, osc, forces;
+  double seconds = 0.0;  // 0: the scene's
+  std::uint64_t steps = 0;
+  int substeps = 0, iterations = 0;  // 0: the scene's
+  double reportEvery = 0.5;
+};
+
+std::string fingerList(const std::array<bool, kFingerCount>& fingers) {
+  std::string s;
+  for (int f = 0; f < kFingerCount; ++f)
+    if (fingers[f]) s += fmt::format("{}{}", s.empty() ? "" : ", ", fingerName(Finger(f)));
+  return s;
+}
+
+void printScene(const BuiltScene& scene) {
+  const SceneSpec& s = scene.spec;
+  for (const SceneBody& b : scene.bodies) {
+    double mass = 0.0;
+    for (float w : b.model->invMass)
+      if (w > 0.0f) mass += 1.0 / w;
+    const Body& body = scene.world->body(b.id);
+    Vec3 lo = Vec3::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
+    for (Index i = body.firstParticle; i < body.firstParticle + body.particleCount; ++i)
+      lo = lo.cwiseMin(scene.world->particles().x[i].pos), hi = hi.cwiseMax(scene.world->particles().x[i].pos);
+    fmt::print("body '{}': {} particles, {} tets, {} triangles, {:.3f} kg{}\n", b.name, b.model->particleCount(),
+               b.model->tets.size(), b.model->triangles.size(), mass,
+               b.embedding ? fmt::format(", render mesh of {} vertices", b.embedding->vertexCount()) : "");
+    fmt::print(
+        "  settled in x [{:.3f}, {:.3f}], y [{:.3f}, {:.3f}], z [{:.3f}, {:.3f}] m; top at ({:.3f}, {:.3f}, {:.3f})\n",
+        lo.x(), hi.x(), lo.y(), hi.y(), lo.z(), hi.z(), b.top.x(), b.top.y(), b.top.z());
+  }
+  fmt::print("solver: dt = {:.6g} s ({:g} Hz), {} substep(s) x {} iteration(s)\n", s.solver.timeStep,
+             1.0 / s.solver.timeStep, s.solver.substeps, s.solver.iterations);
+  if (!s.hand.enabled) return;
+  fmt::print("hand: {} ({}), fingertip radius {:g} mm, contact against {}, grasp {}\n",
+             s.hand.rig.fingers[3] ? "Pro" : "G1", fingerList(s.hand.rig.fingers),
+             1e3f * s.hand.rig.geometry.fingertipRadius,
+             s.hand.rig.contact == FingertipContactMode::Triangles ? "triangles" : "particles",
+             !s.hand.grasp.enabled                   ? "off"
+             : s.hand.grasp.mode == GraspMode::Paper ? "paper"
+                                                     : "local");
+  for (const HandAction& a : scene.actions)
+    fmt::print("  {} with the {} at {:.1f}-{:.1f} s on ({:.3f}, {:.3f}, {:.3f}) m\n",
+               a.kind == ActionKind::Poke ? "poke" : "grasp", fingerName(a.finger), a.start, a.end(), a.target.x(),
+               a.target.y(), a.target.z());
+}
+
+// One summary line per stage like the paper's Table 1 (constraint stages) and the latency table.
+void printSummary(const RunSummary& r, const BuiltScene& scene) {
+  const double simulated = double(r.steps) * r.dt;
+  fmt::print("\nsummary: {} steps ({:.3f} s simulated) in {:.3f} s wall time ({:.1f}x real time)\n", r.steps, simulated,
+             r.wallSeconds, r.wallSeconds > 0 ? simulated / r.wallSeconds : 0.0);
+  fmt::print("  tets {}, particles {}, constraints:", r.tets, r.particles);
+  for (const auto& [type, n] : r.constraints)
+    if (n > 0) fmt::print(" {} {}", type, n);
+  fmt::print("\n  volume loss: max {:.3f}%, final {:.3f}%\n", 100 * r.volumeLossMax, 100 * r.volumeLossFinal);
+  if (scene.spec.hand.enabled) {
+    fmt::print("  force max (normalised, newtons):");
+    for (int f = 0; f < kFingerCount; ++f)
+      if (r.fingers[f]) fmt::print(" {} {:.3f} ({:.3f} N);", fingerName(Finger(f)), r.forceMax[f], r.newtonsMax[f]);
+    fmt::print(" hand (Algorithm 2) {:.3f}\n", r.paperMax);
+  }
+  fmt::print("  NaN events: {}\n", r.nanEvents);
+  for (const std::string& e : r.events) fmt::print("    {}\n", e);
+  const auto mean = [&](Stage s) { return r.latency.stage(s, Phase::All).mean; };
+  const double tv = mean(Stage::Volume), ts = mean(Stage::Strain), tm = mean(Stage::ShapeMatching);
+  const double tc = mean(Stage::Distance), tb = mean(Stage::Bend);
+  if (r.tets > 0)
+    fmt::print(
+        "\nconstraints per frame (paper Table 1): T_v {:.4f} ms, T_s {:.4f} ms, T_m {:.4f} ms, T_total {:.4f} ms\n", tv,
+        ts, tm, tv + ts + tm);
+  else
+    fmt::print("\nconstraints per frame (paper Table 2): T_c {:.4f} ms, T_b {:.4f} ms, T_total {:.4f} ms\n", tc, tb,
+               tc + tb);
+  fmt::print("\nper-stage latency (paper Table 3), ms per step:\n{}", latencyTable(r.latency));
+}
+
+class Progress {
+ public:
+  Progress(double seconds, double reportEvery, double dt, bool hand)
+      : seconds_(seconds),
+        tty_(::isatty(STDOUT_FILENO) == 1),
+        every_(std::max<std::uint64_t>(1, std::llround(reportEvery / dt))),
+        hand_(hand) {
+    if (!tty_)
+      fmt::print("{:>8} {:>8} {:>10} {:>8} {:>8} {:>6} {:>10}\n", "t (s)", "index", "index (N)", "hand", "contacts",
+                 "grasp", "vol. loss");
+  }
+  void step(const RunStep& s) {
+    if (tty_) {
+      const int width = 40;
+      const double done = std::clamp(s.time / seconds_, 0.0, 1.0);
+      const int filled = int(done * width);
+      if (s.step % 8 == 0 || done >= 1.0)
+        fmt::print("\r  [{}{}] {:3.0f}%  {:.2f} / {:.2f} s ", std::string(filled, '#'),
+                   std::string(width - filled, ' '), 100 * done, s.time, seconds_);
+      std::fflush(stdout);
+      return;
+    }
+    if ((s.step + 1) % every_ != 0) return;
+    if (!hand_ || !s.session) {
+      fmt::print("{:8.3f} {:>8} {:>10} {:>8} {:>8} {:>6} {:9.3f}%\n", s.time, "-", "-", "-", "-", "-",
+                 100 * s.volumeLoss);
+      return;
+    }
+    const HapticFrame& h = s.session->haptics();
+    std::size_t contacts = 0;
+    for (const FingerHaptics& f : h.fingers) contacts += f.contacts;
+    const FingerHaptics& index = h.fingers[int(Finger::Index)];
+    fmt::print("{:8.3f} {:8.3f} {:10.4f} {:8.3f} {:8} {:>6} {:9.3f}%\n", s.time, index.force, index.newtons, h.paper,
+               contacts, s.session->grasp().active() ? "on" : "off", 100 * s.volumeLoss);
+  }
+  void finish() {
+    if (tty_) fmt::print("\n");
+  }
+
+ private:
+  double seconds_;
+  bool tty_;
+  std::uint64_t every_;
+  bool hand_;
+};
+
+int run(const RunArgs& a) {
+  SceneSpec spec = loadSceneByName(a.scene);
+  if (a.substeps > 0) spec.solver.substeps = a.substeps;
+  if (a.iterations > 0) spec.solver.iterations = a.iterations;
+  validateSolverSettings(spec.solver);
+  fmt::print("scene {}: {}\n  from {}\n", spec.name, spec.description, spec.source);
+  const auto log = [](std::string_view line) { fmt::print("{}\n", line); };
+  BuiltScene scene = buildScene(spec, log);
+  printScene(scene);
+
+  const double dt = spec.solver.timeStep;
+  std::optional<GloveLink> glove;
+  if (!a.weart.empty()) {
+    if (!spec.hand.enabled) throw Error(fmt::format("scene {} has no hand for the glove to drive", spec.name));
+    const Vec3 point = scene.actions.empty() ? scene.bodies.front().top : scene.actions.front().target;
+    glove.emplace(a.weart, scene.session.hand, point);
+  }
+  std::uint64_t steps = a.steps;
+  if (steps == 0) {
+    const double seconds = a.seconds > 0.0 ? a.seconds : glove ? 1e9 : spec.seconds;
+    steps = std::max<std::uint64_t>(1, std::uint64_t(std::min(std::round(seconds / dt), 1e15)));
+  }
+  const double seconds = double(steps) * dt;
+  fmt::print("running {} steps ({:g} s){}\n\n", steps, seconds, glove ? " in real time" : "");
+
+  RunSettings settings;
+  settings.steps = steps;
+  settings.outDir = a.out;
+  std::vector<std::unique_ptr<HapticOutput>> outputs;
+  if (!a.forces.empty()) outputs.push_back(std::make_unique<CsvRecorder>(a.forces, scene.session.hand.fingers));
+  if (!a.osc.empty()) {
+    const HostPort to = parseHostPort(a.osc);
+    outputs.push_back(std::make_unique<OscOutput>(to.host, to.port));
+  }
+  for (const auto& o : outputs) settings.outputs.push_back(o.get());
+  if (glove) settings.input = &glove->input();
+  Progress progress(seconds, a.reportEvery, dt, spec.hand.enabled);
+  const StopSignals signals;
+  settings.afterStep = [&](const RunStep& s) {
+    progress.step(s);
+    if (glove && s.session) glove->afterStep(s.session->haptics(), s.time);
+    return !signals.requested();
+  };
+  RunSummary summary;
+  try {
+    summary = runScene(scene, settings);
+  } catch (const Error& e) {
+    progress.finish();
+    if (glove) glove->shutdown();
+    fmt::print(stderr, "vrdeform: the run failed: {}\n", e.what());
+    if (!a.out.empty()) fmt::print(stderr, "  {}/summary.json says what ran before\n", a.out);
+    return 1;
+  }
+  progress.finish();
+  if (glove) glove->shutdown();
+  if (signals.requested()) fmt::print("stopped by a signal after {} steps\n", summary.steps);
+  printSummary(summary, scene);
+  if (!summary.files.empty()) {
+    fmt::print("\nwrote into {}:", a.out);
+    for (const auto& f : summary.files) fmt::print(" {}", f.filename().string());
+    fmt::print("\n");
+  }
+  return 0;
+}
+
+int listScenes() {
+  for (const SceneEntry& e : builtinScenes()) {
+    const SceneSpec s = loadSceneByName(e.file.string());
+    fmt::print("{:<10} {}\n", e.name, s.description);
+  }
+  fmt::print("\n(scene files in {}; `vrdeform run NAME` runs one, `vrdeform run FILE.toml` your own)\n",
+             sceneFolder().string());
+  return 0;
+}
+
+}  // namespace
+
+std::function<int()> addRunCommands(CLI::App& app) {
+  auto a = std::make_shared<RunArgs>();
+  CLI::App* run = app.add_subcommand("run", "Simulate a scene headless; print a summary; write outputs with --out");
+  run->add_option("scene", a->scene, "A built-in scene (`vrdeform scenes`) or a scene file (.toml)")->required();
+  auto* seconds = run->add_option("--seconds", a->seconds, "Simulated time after settling (default: the scene's)")
+                      ->check(CLI::Range(1e-6, 1e9));
+  run->add_option("--steps", a->steps, "Number of steps instead of --seconds")
+      ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1e12)))
+      ->excludes(seconds);
+  run->add_option("--out", a->out,
+                  "Write summary.json, forces.csv, stage_times.csv, latency.csv, meshes/*.pvd and plots here");
+  run->add_option("--substeps", a->substeps, "Override the scene's substeps")->check(CLI::Range(1, 1000));
+  run->add_option("--iterations", a->iterations, "Override the scene's iterations")->check(CLI::Range(1, 1000));
+  run->add_option("--report-every", a->reportEvery, "Seconds between timeline rows (when not on a terminal)")
+      ->check(CLI::Range(1e-6, 1e9))
+      ->capture_default_str();
+  run->add_option("--weart", a->weart,
+                  "Drive the hand from a WEART glove and send it the forces, in real time: HOST[:PORT] of the "
+                  "middleware (default port 13031)");
+  run->add_option("--forces", a->forces, "Log every step's per-finger forces with timestamps to this CSV file");
+  run->add_option("--osc", a->osc, "Send every step's forces as OSC over UDP to HOST:PORT (docs/outputs.md)");
+  CLI::App* scenes = app.add_subcommand("scenes", "List the built-in scenes");
+  return [a, run, scenes]() -> int {
+    if (*run) return vrd::run(*a);
+    if (*scenes) return listScenes();
+    return 0;
+  };
+}
+
+}  // namespace vrd

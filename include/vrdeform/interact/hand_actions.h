@@ -1,0 +1,53 @@
+#pragma once
+// Scripted pokes and pinch grasps aimed at points of a body, as fingertip centres given directly
+// (HandFrame::direct). Scenes aim them at a body's top after it settles (scene/scene_spec.h); the
+// `touch` command's standard poke is one of them.
+
+#include <vector>
+
+#include "vrdeform/interact/hand_input.h"
+
+namespace vrd {
+
+enum class ActionKind { Poke, Grasp };
+
+/// One action in world coordinates, timed in simulation seconds. Depths are of a fingertip's lowest
+/// point below `target`; at rest an acting fingertip waits with its lowest point one radius above.
+struct HandAction {
+  ActionKind kind = ActionKind::Poke;
+  Finger finger = Finger::Index;  ///< the poking finger, or the one pinching against the thumb
+  Vec3 target = Vec3::Zero();     ///< the point poked, or the middle of the pinch (on the body's top)
+  double start = 0.0;             ///< s
+  /// Poke: down to `depth` in `approach`, stay `hold`, back up in `release`. Grasp: down to `depth` in
+  /// the first 40% of `approach`, then close the gap in the rest; lift by `lift` in the first third
+  /// of `hold`; lower by half the lift, open (2 cm wider than at the start, so the grasp lets go)
+  /// and rise in three equal parts of `release`, letting the body drop the rest.
+  double approach = 1.0, hold = 1.0, release = 1.0;
+  float depth = 0.01f;  ///< m
+  float width = 0.0f;   ///< grasp: gap between the fingertips' surfaces before closing (m); 0: 4 radii
+  float lift = 0.0f;    ///< grasp: m
+
+  double end() const { return start + approach + hold + release; }
+};
+
+/// Plays actions one after another (they may not overlap: vrd::Error). Fingertips not acting wait
+/// 1 m above the current (or next, or last) target, spaced 5 cm apart.
+class HandActionsInput final : public HandInput {
+ public:
+  /// Throws vrd::Error for non-finite or negative values, overlapping actions or a grasp by the thumb.
+  HandActionsInput(std::vector<HandAction> actions, float fingertipRadius);
+
+  HandFrame frame(std::uint64_t step, double time) override;
+  /// After the last action has ended (or for a NaN time).
+  bool finished(std::uint64_t step, double time) const override;
+  const std::vector<HandAction>& actions() const { return actions_; }
+
+ private:
+  std::vector<HandAction> actions_;  // sorted by start
+  float radius_;
+};
+
+/// Fingertip centres of `action` at `time` (the acting ones; others as `parked`).
+HandFrame actionFrame(const HandAction& action, float fingertipRadius, double time);
+
+}  // namespace vrd

@@ -1,0 +1,65 @@
+#pragma once
+// Runs a built scene headless: the hand (scripted, or any HandInput such as a glove) on the world
+// through a HapticSession, step by step, collecting what `vrdeform run` reports and writes
+// (docs/scenes.md#outputs): summary.json, the per-finger force trace, per-stage latencies, the
+// deformed meshes for ParaView and plots of force against time and against indentation.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "vrdeform/devices/haptic_output.h"
+#include "vrdeform/metrics/latency_stats.h"
+#include "vrdeform/scene/scene_builder.h"
+
+namespace vrd {
+
+/// One finished step, for progress reports and real-time pacing.
+struct RunStep {
+  std::uint64_t step = 0;                  ///< 0-based, counted from the end of settling
+  double time = 0.0;                       ///< s since the end of settling, at the end of this step
+  const HapticSession* session = nullptr;  ///< null in a scene without a hand
+  double volumeLoss = 0.0;                 ///< largest over the soft bodies, this step
+};
+
+struct RunSettings {
+  std::uint64_t steps = 0;             ///< steps to run (the hand input may not end them earlier)
+  std::filesystem::path outDir;        ///< where the files go; empty: none
+  HandInput* input = nullptr;          ///< replaces the scene's scripted hand (e.g. a glove); may be null
+  std::vector<HapticOutput*> outputs;  ///< also receive every step's signal (OSC, a CSV log, ...)
+  /// Called after every step; returning false ends the run there (Ctrl-C, a real-time pace).
+  std::function<bool(const RunStep&)> afterStep;
+};
+
+struct RunSummary {
+  std::string scene;
+  std::uint64_t steps = 0;
+  double dt = 0.0;
+  std::size_t tets = 0, particles = 0;
+  std::map<std::string, std::size_t> constraints;  ///< count per type ("volume", "strain", ...)
+  /// |v0 - v| / v0 (a gain counts as much as a loss), largest over the soft bodies
+  double volumeLossMax = 0.0, volumeLossFinal = 0.0;
+  std::array<bool, kFingerCount> fingers{};  ///< the hand's fingers
+  std::array<float, kFingerCount> forceMax{}, newtonsMax{};
+  float paperMax = 0.0f;
+  std::uint64_t nanEvents = 0;  ///< bodies frozen or particles reset after a NaN
+  std::vector<std::string> events;
+  LatencyRecorder latency;  ///< per step: idle (no finger touching, no grasp) or contact
+  double wallSeconds = 0.0;
+  bool ok = false;
+  std::string error;
+  std::vector<std::filesystem::path> files;  ///< written into outDir
+};
+
+/// Runs the scene. With an outDir, writes every output there (creating the folder) and
+/// summary.json last, also when the run fails (then with ok = false and the error), and rethrows.
+RunSummary runScene(BuiltScene& scene, const RunSettings& settings);
+
+/// summary.json's text (docs/scenes.md lists the keys).
+std::string summaryJson(const RunSummary& summary);
+
+}  // namespace vrd

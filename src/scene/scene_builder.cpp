@@ -1,0 +1,249 @@
+#include "vrdeform/scene/scene_builder.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "vrdeform/error.h"
+#include "vrdeform/interact/hand_script.h"
+#include "vrdeform/io/surface_io.h"
+#include "vrdeform/io/tet_io.h"
+
+namespace vrd {
+namespace {
+
+namespace fs = std::filesystem;
+
+void say(const SceneLog& log, const std::string& line) {
+  if (log) log(line);
+}
+
+std::uint64_t fnv1a(std::uint64_t h, const void* data, std::size_t bytes) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
+  return h;
+}
+
+// A fingerprint of a mesh as read, so that a replay notices an edited file.
+template <typename Element>
+std::uint64_t meshHash(const std::vector<Vec3>& vertices, const std::vector<Element>& elements) {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  for (const Vec3& v : vertices) h = fnv1a(h, v.data(), 3 * sizeof(float));
+  for (const Element& e : elements) h = fnv1a(h, e.data(), sizeof(e));
+  return h;
+}
+
+Mat3 rotationOf(const std::array<float, 3>& degrees) {
+  const float k = float(M_PI / 180.0);
+  return (Eigen::AngleAxisf(k * degrees[2], Vec3::UnitZ()) * Eigen::AngleAxisf(k * degrees[1], Vec3::UnitY()) *
+          Eigen::AngleAxisf(k * degrees[0], Vec3::UnitX()))
+      .toRotationMatrix();
+}
+
+std::string fileName(const std::string& path) { return fs::path(path).filename().string(); }
+
+}  // namespace
+
+PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log) {
+  PlacedMesh out;
+  const std::string name = fileName(body.mesh);
+  if (body.kind == BodyKind::Cloth) {
+    out.surface = readSurface(body.mesh);
+    out.hash = meshHash(out.surface.vertices, out.surface.triangles);
+    out.tets.vertices = out.surface.vertices;
+    say(log, fmt::format("mesh: {} ({} triangles), cloth", name, out.surface.triangles.size()));
+  } else if (isSurfaceFile(body.mesh)) {
+    TriMesh surface = readSurface(body.mesh);
+    out.hash = meshHash(surface.vertices, surface.triangles);
+    for (Vec3& v : surface.vertices) v *= body.scale;
+    const auto start = std::chrono::steady_clock::now();
+    out.tets = tetrahedralise(surface, body.mesher).mesh;
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    say(log,
+        fmt::format("mesh: {} ({} triangles) x {:g}: {} tets from the {} mesher in {:.2f} s", name,
+                    surface.triangles.size(), body.scale, out.tets.tets.size(), toString(body.mesher.mesher), seconds));
+  } else {
+    out.tets = readTetMesh(body.mesh);
+    out.hash = meshHash(out.tets.vertices, out.tets.tets);
+    const std::size_t dropped = removeUnusedVertices(out.tets);
+    say(log, fmt::format("mesh: {}: {} tets, used as is{}", name, out.tets.tets.size(),
+                         dropped > 0 ? fmt::format(" (dropped {} vertices no tet uses)", dropped) : ""));
+  }
+  if (!body.renderMesh.empty()) {
+    out.render = readSurface(body.renderMesh);
+    say(log, fmt::format("render mesh: {} ({} vertices, {} triangles)", fileName(body.renderMesh),
+                         out.render.vertices.size(), out.render.triangles.size()));
+  }
+  if (out.tets.vertices.empty()) throw Error(fmt::format("{}: no vertices", body.mesh));
+
+  // Scale (tetrahedralised surfaces were scaled before meshing), rotate, then place.
+  const bool scaled = body.kind == BodyKind::Soft && isSurfaceFile(body.mesh);
+  const Mat3 rotation = rotationOf(body.rotationDeg);
+  const auto transform = [&](std::vector<Vec3>& vertices, bool alreadyScaled) {
+    for (Vec3& v : vertices) v = rotation * (alreadyScaled ? v : Vec3(body.scale * v));
+  };
+  transform(out.tets.vertices, scaled);
+  transform(out.surface.vertices, false);
+  transform(out.render.vertices, false);
+  Vec3 lo = out.tets.vertices.front(), hi = lo;
+  for (const Vec3& v : out.tets.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  if (!isFinite(lo) || !isFinite(hi)) throw Error(fmt::format("{}: coordinates overflow after scaling", body.mesh));
+  const Vec3 shift = body.placement == Placement::Ground
+                         ? Vec3(body.position.x() - 0.5f * (lo.x() + hi.x()), body.position.y() - lo.y(),
+                                body.position.z() - 0.5f * (lo.z() + hi.z()))
+                         : body.position;
+  for (std::vector<Vec3>* vs : {&out.tets.vertices, &out.surface.vertices, &out.render.vertices})
+    for (Vec3& v : *vs) v += shift;
+  return out;
+}
+
+Vec3 topPoint(const World& world, BodyId id) {
+  const Body& b = world.body(id);
+  const auto& x = world.particles().x;
+  Vec3 low = Vec3::Constant(std::numeric_limits<float>::infinity()), high = -low;
+  for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i)
+    low = low.cwiseMin(x[i].pos), high = high.cwiseMax(x[i].pos);
+  const float nearTop = high.y() - 0.01f * (high.y() - low.y());
+  const Vec3 middle = 0.5f * (low + high);
+  float best = std::numeric_limits<float>::infinity();
+  Vec3 top = Vec3::Constant(std::numeric_limits<float>::quiet_NaN());
+  for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
+    const Vec3& p = x[i].pos;
+    const float off = Vec3(p.x() - middle.x(), 0.0f, p.z() - middle.z()).squaredNorm();
+    if (p.y() >= nearTop && off < best) best = off, top = p;
+  }
+  return top;
+}
+
+// The highest particle of a body within `reach` of the vertical through `at` (x, z), or `at` when
+// there is none: where a fingertip coming down there first meets the body.
+Vec3 surfaceBelow(const World& world, BodyId id, const Vec3& at, float reach) {
+  const Body& b = world.body(id);
+  Vec3 best = at;
+  float height = -std::numeric_limits<float>::infinity();
+  for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
+    const Vec3& p = world.particles().x[i].pos;
+    if (Vec3(p.x() - at.x(), 0.0f, p.z() - at.z()).norm() <= reach && p.y() > height)
+      height = p.y(), best = Vec3(at.x(), p.y(), at.z());
+  }
+  return best;
+}
+
+const SceneBody& BuiltScene::body(std::string_view name) const {
+  for (const SceneBody& b : bodies)
+    if (b.name == name) return b;
+  throw Error(fmt::format("scene {}: no body named '{}'", spec.name, name));
+}
+
+BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log) {
+  BuiltScene scene;
+  scene.spec = spec;
+  if (spec.bodies.empty()) throw Error(fmt::format("scene {}: no bodies", spec.name));
+  scene.world = std::make_unique<World>(spec.solver);
+  World& world = *scene.world;
+
+  for (const BodySpec& b : spec.bodies) {
+    SceneBody body;
+    body.name = b.name;
+    body.kind = b.kind;
+    try {
+      body.mesh = placeBodyMesh(b, log);
+      if (b.kind == BodyKind::Cloth) {
+        body.model = makeCloth(body.mesh.surface, b.material);
+      } else {
+        body.model = makeSoftBody(body.mesh.tets, b.material, b.constraints);
+        if (!body.mesh.render.vertices.empty()) body.embedding = Embedding::bind(body.mesh.tets, body.mesh.render);
+      }
+    } catch (const Error& e) {
+      throw Error(fmt::format("body '{}': {}", b.name, e.what()));
+    }
+    body.id = world.addBody(body.model);
+    const Vec3 force = b.force + (b.kind == BodyKind::Cloth ? spec.wind : Vec3::Zero());
+    if (force != Vec3::Zero()) world.setExternalForce(body.id, force);
+    if (!b.pin.empty()) {
+      const auto& v = body.mesh.tets.vertices;
+      Vec3 lo = v.front(), hi = lo;
+      for (const Vec3& p : v) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+      std::size_t pinned = 0;
+      for (Index i = 0; i < v.size(); ++i)
+        for (const std::string& side : b.pin) {
+          const int axis = side[1] - 'x';
+          const float bound = side[0] == '-' ? lo[axis] : hi[axis];
+          if (std::abs(v[i][axis] - bound) <= b.pinTolerance) {
+            world.setInverseMass(world.particleIndex(body.id, i), 0.0f);
+            ++pinned;
+            break;
+          }
+        }
+      if (pinned == 0) throw Error(fmt::format("body '{}': pin {} holds no particle", b.name, b.pin.front()));
+      say(log, fmt::format("body '{}': {} particles pinned", b.name, pinned));
+    }
+    scene.bodies.push_back(std::move(body));
+  }
+  for (const Collider& c : spec.colliders) world.addCollider(c);
+
+  const long settleSteps = std::lround(spec.settle / double(spec.solver.timeStep));
+  for (long k = 0; k < settleSteps; ++k) world.step();
+  scene.settleSeconds = double(settleSteps) * spec.solver.timeStep;
+  for (const SimEvent& e : world.takeEvents()) say(log, fmt::format("event while settling: {}", e.message));
+  for (SceneBody& b : scene.bodies) {
+    b.top = topPoint(world, b.id);
+    if (!isFinite(b.top)) throw Error(fmt::format("body '{}' did not settle to finite positions", b.name));
+  }
+  say(log, fmt::format("settled for {:g} s", scene.settleSeconds));
+
+  const HandSpec& hand = spec.hand;
+  scene.session.hand = hand.rig;
+  scene.session.grasp = hand.grasp;
+  scene.session.haptics = spec.haptics.settings;
+  if (!hand.enabled) return scene;
+
+  for (const ActionSpec& a : hand.actions) {
+    const SceneBody& target = a.body.empty() ? scene.bodies.front() : scene.body(a.body);
+    HandAction action;
+    action.kind = a.kind;
+    action.finger = a.finger;
+    action.target = target.top;
+    if (a.offset.x() != 0.0f || a.offset.z() != 0.0f)
+      action.target = surfaceBelow(world, target.id, target.top + Vec3(a.offset.x(), 0.0f, a.offset.z()),
+                                   2.0f * hand.rig.geometry.fingertipRadius);
+    action.start = a.start;
+    action.approach = a.approach, action.hold = a.hold, action.release = a.release;
+    action.depth = a.depth, action.width = a.width, action.lift = a.lift;
+    scene.actions.push_back(action);
+  }
+  const float radius = hand.rig.geometry.fingertipRadius;
+  if (!hand.script.empty())
+    scene.input = std::make_unique<HandScriptInput>(HandScript::load(hand.script));
+  else if (!scene.actions.empty())
+    scene.input = std::make_unique<HandActionsInput>(scene.actions, radius);
+
+  if (spec.haptics.calibrate) {
+    // Calibrate where the first action goes (else on the first body's top), as the hand will touch.
+    const SceneBody* body = &scene.bodies.front();
+    CalibrationSettings c;
+    c.radius = radius;
+    c.contact = hand.rig.contact;
+    c.point = body->top;
+    if (!hand.actions.empty()) {
+      const ActionSpec& first = hand.actions.front();
+      body = first.body.empty() ? body : &scene.body(first.body);
+      c.point = scene.actions.front().target;
+    }
+    try {
+      scene.calibration = calibrateHaptics(world, body->id, scene.session.haptics.signal, c);
+    } catch (const Error& e) {
+      throw Error(fmt::format("calibrating the haptics on body '{}': {}", body->name, e.what()));
+    }
+    scene.session.haptics.signal = scene.calibration->signal;
+    say(log, fmt::format("haptics calibrated on '{}': a standard poke {:.1f} mm deep gave {:.4f} N over {} contacts",
+                         body->name, 1e3f * scene.calibration->depth, scene.calibration->force,
+                         scene.calibration->contacts));
+  }
+  return scene;
+}
+
+}  // namespace vrd

@@ -1,0 +1,271 @@
+#include "vrdeform/scene/scene_run.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "vrdeform/devices/csv_recorder.h"
+#include "vrdeform/error.h"
+#include "vrdeform/io/svg_plot.h"
+#include "vrdeform/io/vtu_sequence.h"
+#include "vrdeform/io/write_file.h"
+
+namespace vrd {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::map<std::string, std::size_t> constraintCounts(const std::vector<SceneBody>& bodies) {
+  std::map<std::string, std::size_t> n{
+      {"distance", 0}, {"volume", 0}, {"strain", 0}, {"bend", 0}, {"shape_matching", 0}};
+  for (const SceneBody& b : bodies) {
+    n["distance"] += b.model->distance.size();
+    n["volume"] += b.model->volume.size();
+    n["strain"] += b.model->strain.size();
+    n["bend"] += b.model->bend.size();
+    n["shape_matching"] += b.model->shapeMatching ? 1 : 0;
+  }
+  return n;
+}
+
+// The files of a run with an outDir; each output only exists when it applies.
+class RunFiles {
+ public:
+  RunFiles(const BuiltScene& scene, const fs::path& dir, const std::array<bool, kFingerCount>& fingers)
+      : dir_(dir), fingers_(fingers) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw Error(fmt::format("{}: cannot create the folder: {}", dir.string(), ec.message()));
+    forces_.emplace(dir / "forces.csv", fingers);
+    stageCsv_ = "step,time_s,phase";
+    for (std::size_t s = 0; s < kStageCount; ++s) (stageCsv_ += ',') += fmt::format("{}_ms", stageName(Stage(s)));
+    stageCsv_ += ",total_ms\n";
+    const double every = scene.spec.output.meshEvery;
+    if (every > 0.0) {
+      fs::create_directories(dir / "meshes", ec);
+      if (ec) throw Error(fmt::format("{}: cannot create the folder: {}", (dir / "meshes").string(), ec.message()));
+      meshEvery_ = std::max<std::uint64_t>(1, std::uint64_t(std::llround(every / scene.spec.solver.timeStep)));
+      for (const SceneBody& b : scene.bodies)
+        if (b.kind == BodyKind::Soft)
+          meshes_.push_back({&b, std::make_unique<VtuSequence>(dir / "meshes" / (b.name + ".pvd"), b.mesh.tets)});
+    }
+  }
+
+  void step(const BuiltScene& scene, const HapticSession& session, std::uint64_t k, double t, bool contact) {
+    forces_->send(sampleOf(t, session.haptics(), fingers_));
+    const StageTimes& times = session.times();
+    stageCsv_ += fmt::format("{},{:.6f},{}", k, t, contact ? "contact" : "idle");
+    for (double ms : times.ms) stageCsv_ += fmt::format(",{:.5f}", ms);
+    stageCsv_ += fmt::format(",{:.5f}\n", times.totalMs());
+    if (meshEvery_ > 0 && (k + 1) % meshEvery_ == 0) {
+      for (auto& [body, sequence] : meshes_) {
+        const Body& b = scene.world->body(body->id);
+        positions_.resize(b.particleCount);
+        for (Index i = 0; i < b.particleCount; ++i) positions_[i] = scene.world->particles().x[b.firstParticle + i].pos;
+        sequence->addFrame(t, positions_);
+      }
+    }
+  }
+
+  // Everything but summary.json; the plots from the per-step traces.
+  void finish(const RunSummary& summary, const std::vector<double>& time,
+              const std::array<std::vector<double>, kFingerCount>& force, const std::vector<double>& paper,
+              const std::array<PlotSeries, kFingerCount>& indentation, std::vector<fs::path>& files) {
+    forces_.reset();  // flushes and closes
+    files.push_back(dir_ / "forces.csv");
+    writeFile(dir_ / "stage_times.csv", stageCsv_);
+    files.push_back(dir_ / "stage_times.csv");
+    writeFile(dir_ / "latency.csv", latencyCsv(summary.latency));
+    files.push_back(dir_ / "latency.csv");
+    for (const auto& m : meshes_) files.push_back(dir_ / "meshes" / (m.body->name + ".pvd"));
+
+    Plot overTime{fmt::format("{}: haptic force", summary.scene), "time (s)", "force (normalised)", {}, {{0.0, 1.0}}};
+    for (int f = 0; f < kFingerCount; ++f)
+      if (fingers_[f]) overTime.series.push_back({std::string(fingerName(Finger(f))), time, force[f]});
+    overTime.series.push_back({"hand (Algorithm 2)", time, paper});
+    writeSvgPlot(dir_ / "force_time.svg", overTime);
+    files.push_back(dir_ / "force_time.svg");
+
+    Plot overDepth{fmt::format("{}: force against indentation (pokes)", summary.scene),
+                   "indentation (mm)",
+                   "force (N)",
+                   {},
+                   std::nullopt};
+    for (const PlotSeries& s : indentation)
+      if (!s.x.empty()) overDepth.series.push_back(s);
+    if (!overDepth.series.empty()) {
+      writeSvgPlot(dir_ / "force_indentation.svg", overDepth);
+      files.push_back(dir_ / "force_indentation.svg");
+    }
+  }
+
+ private:
+  struct Meshes {
+    const SceneBody* body;
+    std::unique_ptr<VtuSequence> sequence;
+  };
+  fs::path dir_;
+  std::array<bool, kFingerCount> fingers_;
+  std::optional<CsvRecorder> forces_;
+  std::string stageCsv_;
+  std::uint64_t meshEvery_ = 0;
+  std::vector<Meshes> meshes_;
+  std::vector<Vec3> positions_;
+};
+
+// The poke under way at time t, if any.
+const HandAction* pokeAt(const std::vector<HandAction>& actions, double t) {
+  for (const HandAction& a : actions)
+    if (a.kind == ActionKind::Poke && t >= a.start && t < a.end()) return &a;
+  return nullptr;
+}
+
+}  // namespace
+
+RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
+  World& world = *scene.world;
+  RunSummary summary;
+  summary.scene = scene.spec.name;
+  summary.dt = world.settings().timeStep;
+  for (const SceneBody& b : scene.bodies) {
+    summary.tets += b.model->tets.size();
+    summary.particles += b.model->particleCount();
+  }
+  summary.constraints = constraintCounts(scene.bodies);
+  summary.fingers = scene.spec.hand.enabled ? scene.session.hand.fingers : std::array<bool, kFingerCount>{};
+  summary.latency.reserve(std::size_t(std::min<std::uint64_t>(settings.steps, 1u << 22)));
+
+  std::unique_ptr<RunFiles> files;
+  std::vector<double> time, paper;
+  std::array<std::vector<double>, kFingerCount> force;
+  std::array<PlotSeries, kFingerCount> indentation;
+  for (int f = 0; f < kFingerCount; ++f) indentation[f].label = std::string(fingerName(Finger(f)));
+
+  HandInput* input = settings.input ? settings.input : scene.input.get();
+  std::optional<HapticSession> session;
+  if (scene.spec.hand.enabled) session.emplace(world, scene.session, input ? input->frame(0, 0.0) : HandFrame{});
+  const float radius = scene.session.hand.geometry.fingertipRadius;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    if (!settings.outDir.empty()) files = std::make_unique<RunFiles>(scene, settings.outDir, summary.fingers);
+    for (std::uint64_t k = 0; k < settings.steps; ++k) {
+      const double t = double(k + 1) * summary.dt;
+      bool contact = false;
+      if (session) {
+        session->step(input ? input->frame(k, double(k) * summary.dt) : HandFrame{});
+        contact = session->grasp().active();
+        for (const FingerHaptics& f : session->haptics().fingers) contact = contact || f.contacts > 0;
+      } else {
+        world.step();
+      }
+      StageTimes times = session ? session->times() : world.lastStep().times;
+      summary.latency.add(times, contact);
+      for (const SimEvent& e : world.takeEvents()) {
+        ++summary.nanEvents;
+        summary.events.push_back(fmt::format("step {}: {}", e.step, e.message));
+      }
+      double loss = 0.0;
+      for (const SceneBody& b : scene.bodies)
+        if (b.kind == BodyKind::Soft) loss = std::max(loss, std::abs(world.volumeLoss(b.id)));
+      summary.volumeLossMax = std::max(summary.volumeLossMax, loss);
+      summary.volumeLossFinal = loss;
+      summary.steps = k + 1;
+
+      if (session) {
+        const HapticFrame& h = session->haptics();
+        const HapticSample sample = sampleOf(t, h, summary.fingers);
+        for (HapticOutput* out : settings.outputs) out->send(sample);
+        summary.paperMax = std::max(summary.paperMax, h.paper);
+        time.push_back(t);
+        paper.push_back(h.paper);
+        for (int f = 0; f < kFingerCount; ++f) {
+          summary.forceMax[f] = std::max(summary.forceMax[f], h.fingers[f].force);
+          summary.newtonsMax[f] = std::max(summary.newtonsMax[f], h.fingers[f].newtons);
+          force[f].push_back(h.fingers[f].force);
+        }
+        if (const HandAction* poke =
+                input == scene.input.get() ? pokeAt(scene.actions, double(k) * summary.dt) : nullptr) {
+          const float tipLow = session->rig().target(poke->finger).y() - radius;
+          PlotSeries& s = indentation[int(poke->finger)];
+          s.x.push_back(1e3 * std::max(0.0f, poke->target.y() - tipLow));
+          s.y.push_back(h.fingers[int(poke->finger)].newtons);
+        }
+        if (files) files->step(scene, *session, k, t, contact);
+      }
+      if (settings.afterStep && !settings.afterStep(RunStep{k, t, session ? &*session : nullptr, loss})) break;
+    }
+    summary.ok = true;
+  } catch (const std::exception& e) {
+    summary.error = e.what();
+  }
+  for (HapticOutput* out : settings.outputs) out->release();
+  summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (files && summary.ok) {
+    try {
+      files->finish(summary, time, force, paper, indentation, summary.files);
+    } catch (const std::exception& e) {
+      summary.ok = false;
+      summary.error = e.what();
+    }
+  }
+  if (!settings.outDir.empty()) {
+    std::error_code ec;
+    fs::create_directories(settings.outDir, ec);  // a failed run may not have made it
+    writeFile(settings.outDir / "summary.json", summaryJson(summary));
+    summary.files.push_back(settings.outDir / "summary.json");
+  }
+  if (!summary.ok) throw Error(summary.error);
+  return summary;
+}
+
+std::string summaryJson(const RunSummary& s) {
+  using nlohmann::json;
+  // JSON has no NaN: a value that is not finite (no frames in a phase) becomes null.
+  const auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  json j;
+  j["scene"] = s.scene;
+  j["ok"] = s.ok;
+  if (!s.ok) j["error"] = s.error;
+  j["steps"] = s.steps;
+  j["dt"] = s.dt;
+  j["tets"] = s.tets;
+  j["particles"] = s.particles;
+  j["constraints"] = s.constraints;
+  j["volume_loss_max"] = number(s.volumeLossMax);
+  j["volume_loss_final"] = number(s.volumeLossFinal);
+  json forceMax = json::object(), newtonsMax = json::object();
+  for (int f = 0; f < kFingerCount; ++f)
+    if (s.fingers[f]) {
+      forceMax[std::string(fingerName(Finger(f)))] = number(s.forceMax[f]);
+      newtonsMax[std::string(fingerName(Finger(f)))] = number(s.newtonsMax[f]);
+    }
+  j["force_max"] = forceMax;
+  j["newtons_max"] = newtonsMax;
+  j["paper_force_max"] = number(s.paperMax);
+  json stages = json::object();
+  const auto stats = [&](const SampleStats& st) {
+    return json{{"mean", number(st.mean)}, {"p50", number(st.median)}, {"p95", number(st.p95)},
+                {"p99", number(st.p99)},   {"std", number(st.stddev)}, {"max", number(st.max)}};
+  };
+  for (std::size_t k = 0; k < kStageCount; ++k) {
+    const SampleStats st = s.latency.stage(Stage(k), Phase::All);
+    if (st.count > 0 && st.max > 0.0) stages[std::string(stageName(Stage(k)))] = stats(st);
+  }
+  stages["total"] = stats(s.latency.total(Phase::All));
+  j["stage_ms"] = stages;
+  j["frames"] = {{"idle", s.latency.frames(Phase::Idle)}, {"contact", s.latency.frames(Phase::Contact)}};
+  j["nan_events"] = s.nanEvents;
+  j["events"] = s.events;
+  j["wall_seconds"] = s.wallSeconds;
+  json files = json::array();
+  for (const auto& f : s.files) files.push_back(f.filename().string());
+  j["files"] = files;
+  return j.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
+}
+
+}  // namespace vrd

@@ -1,0 +1,140 @@
+// The built-in scenes (scenes/*.toml: the paper's six) and running them (scene/scene_run.h).
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "test_support.h"
+#include "vrdeform/scene/scene_library.h"
+#include "vrdeform/scene/scene_run.h"
+
+namespace vrd {
+namespace {
+
+std::vector<std::string> names() {
+  std::vector<std::string> n;
+  for (const SceneEntry& e : builtinScenes()) n.push_back(e.name);
+  return n;
+}
+
+TEST(Scenes, ThePapersSixAreBuiltIn) {
+  EXPECT_EQ(names(), (std::vector<std::string>{"balloon", "bear", "flag", "furball", "jelly", "liver"}));
+}
+
+// The paper's tet counts (Table 1): the meshers land within 15% of them.
+TEST(Scenes, TetCountsAreNearThePapers) {
+  const std::map<std::string, std::size_t> paper{
+      {"furball", 1280}, {"liver", 770}, {"balloon", 1713}, {"jelly", 1530}, {"bear", 1041}};
+  for (const auto& [name, tets] : paper) {
+    SceneSpec spec = loadSceneByName(name);
+    spec.settle = 0.0;
+    spec.haptics.calibrate = false;
+    const BuiltScene scene = buildScene(spec);
+    const double n = double(scene.bodies.front().model->tets.size());
+    EXPECT_NEAR(n / double(tets), 1.0, 0.15) << name << ": " << n << " tets";
+  }
+}
+
+class EveryScene : public ::testing::TestWithParam<std::string> {};
+
+// Two simulated seconds after settling, with the scripted poke under way: finite, volume kept to
+// within the paper's 1%, forces in [0, 1] and the poking finger feeling the body.
+TEST_P(EveryScene, RunsTwoSecondsWithoutNaNKeepingItsVolume) {
+  BuiltScene scene = buildScene(loadSceneByName(GetParam()));
+  RunSettings settings;
+  settings.steps = std::uint64_t(std::lround(2.0 / scene.spec.solver.timeStep));
+  float lowest = 1.0f, highest = 0.0f;
+  settings.afterStep = [&](const RunStep& s) {
+    for (const FingerHaptics& f : s.session->haptics().fingers) {
+      lowest = std::min(lowest, f.force);
+      highest = std::max(highest, f.force);
+    }
+    return true;
+  };
+  const RunSummary r = runScene(scene, settings);
+  EXPECT_TRUE(r.ok);
+  EXPECT_EQ(r.steps, settings.steps);
+  EXPECT_EQ(r.nanEvents, 0u);
+  for (Index i = 0; i < scene.world->particles().x.size(); ++i)
+    ASSERT_TRUE(isFinite(scene.world->particles().x[i].pos)) << "particle " << i;
+  EXPECT_LT(r.volumeLossMax, 0.01);
+  EXPECT_GE(lowest, 0.0f);
+  EXPECT_LE(highest, 1.0f);
+  EXPECT_GT(r.forceMax[int(Finger::Index)], 0.1f) << "the poke should be felt within 2 s";
+  testing::record("volume_loss_max", r.volumeLossMax);
+  testing::record("index_force_max", r.forceMax[int(Finger::Index)]);
+}
+
+INSTANTIATE_TEST_SUITE_P(Builtin, EveryScene,
+                         ::testing::Values("balloon", "bear", "flag", "furball", "jelly", "liver"));
+
+TEST(SceneRun, WritesEveryOutputAndASummaryWithTheDocumentedKeys) {
+  const testing::TempDir dir;
+  SceneSpec spec = loadSceneByName("liver");
+  spec.output.meshEvery = 0.5;
+  BuiltScene scene = buildScene(spec);
+  RunSettings settings;
+  settings.steps = 150;  // 2.5 s: into the poke's hold
+  settings.outDir = dir.path() / "out";
+  const RunSummary r = runScene(scene, settings);
+  for (const char* f :
+       {"summary.json", "forces.csv", "stage_times.csv", "latency.csv", "force_time.svg", "force_indentation.svg",
+        "meshes/liver.pvd", "meshes/liver_00000.vtu", "meshes/liver_00004.vtu"})
+    EXPECT_TRUE(std::filesystem::is_regular_file(settings.outDir / f)) << f;
+
+  std::ifstream in(settings.outDir / "summary.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  for (const char* key : {"scene", "steps", "dt", "tets", "particles", "constraints", "volume_loss_max",
+                          "volume_loss_final", "force_max", "stage_ms", "nan_events", "ok"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["scene"], "liver");
+  EXPECT_EQ(j["steps"], 150);
+  EXPECT_EQ(j["ok"], true);
+  EXPECT_EQ(j["tets"], r.tets);
+  EXPECT_EQ(j["constraints"]["volume"], r.tets);
+  EXPECT_EQ(j["constraints"]["shape_matching"], 1);
+  EXPECT_DOUBLE_EQ(j["force_max"]["index"].get<double>(), double(r.forceMax[int(Finger::Index)]));
+  for (const char* stat : {"mean", "p50", "p95", "p99"}) EXPECT_GT(j["stage_ms"]["total"][stat].get<double>(), 0.0);
+  EXPECT_LE(j["stage_ms"]["total"]["p50"].get<double>(), j["stage_ms"]["total"]["p99"].get<double>());
+
+  // The force trace: a header and a row per step, time increasing.
+  std::ifstream csv(settings.outDir / "forces.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "time_s,wall_ms,paper,thumb,index,middle,thumb_N,index_N,middle_N");
+  std::size_t rows = 0;
+  while (std::getline(csv, line)) ++rows;
+  EXPECT_EQ(rows, 150u);
+}
+
+TEST(SceneRun, AFailedRunStillLeavesASummarySayingSo) {
+  const testing::TempDir dir;
+  SceneSpec spec = loadSceneByName("jelly");
+  spec.settle = 0.0;
+  spec.haptics.calibrate = false;
+  BuiltScene scene = buildScene(spec);
+  RunSettings settings;
+  settings.steps = 10;
+  settings.outDir = dir.path() / "out";
+  settings.afterStep = [](const RunStep& s) -> bool {
+    if (s.step == 4) throw Error("disk full");
+    return true;
+  };
+  EXPECT_NE(testing::errorOf([&] { runScene(scene, settings); }).find("disk full"), std::string::npos);
+  std::ifstream in(settings.outDir / "summary.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["ok"], false);
+  EXPECT_EQ(j["steps"], 5);
+  EXPECT_EQ(j["error"], "disk full");
+}
+
+TEST(SceneLibrary, UnknownNamesListTheBuiltInScenes) {
+  const std::string e = testing::errorOf([] { loadSceneByName("livr"); });
+  EXPECT_NE(e.find("no built-in scene 'livr'"), std::string::npos) << e;
+  EXPECT_NE(e.find("liver"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace vrd
