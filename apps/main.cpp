@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "bench_command.h"
 #include "mesh_commands.h"
 #include "run_command.h"
 #include "touch_command.h"
@@ -15,12 +16,14 @@ int main(int argc, char** argv) {
   const auto runRunCommand = vrd::addRunCommands(app);
   const auto runMeshCommand = vrd::addMeshCommands(app);
   const auto runTouchCommand = vrd::addTouchCommand(app);
+  const auto runBenchCommand = vrd::addBenchCommand(app);
 
   CLI11_PARSE(app, argc, argv);
   try {
     if (app.got_subcommand("run") || app.got_subcommand("scenes")) return runRunCommand();
     if (app.got_subcommand("mesh")) return runMeshCommand();
     if (app.got_subcommand("touch")) return runTouchCommand();
+    if (app.got_subcommand("bench")) return runBenchCommand();
   } catch (const vrd::Error& e) {
     fmt::print(stderr, "vrdeform: {}\n", e.what());
     return 2;

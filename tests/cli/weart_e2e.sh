@@ -1,9 +1,11 @@
 #!/bin/sh
-# End to end with a (fake) glove: the fake middleware closes the hand over 1 s; `vrdeform touch
-# --weart` must press the liver, send forces, and leave every thimble stopped when it ends.
-# Usage: touch_weart.sh VRDEFORM FAKE_WEART LIVER_OBJ SCRATCH_DIR
+# End to end with a (fake) glove: the fake middleware closes the hand over 1 s; `vrdeform ARGS...
+# --weart` (touch or run on the liver) must press it, send forces, and leave every thimble stopped
+# when it ends.
+# Usage: weart_e2e.sh VRDEFORM FAKE_WEART SCRATCH_DIR ARGS...
 set -eu
-vrdeform=$1 fake=$2 liver=$3 dir=$4
+vrdeform=$1 fake=$2 dir=$3
+shift 3
 mkdir -p "$dir"
 printf '# t thumb index middle\n0 0 0 0\n1 0.9 0.9 0.9\n' > "$dir/close.script"
 "$fake" --port 0 --seconds 20 --script "$dir/close.script" --log "$dir/fake.log" > "$dir/fake.out" 2>&1 &
@@ -12,11 +14,11 @@ trap 'kill $pid 2>/dev/null || true' EXIT
 for _ in $(seq 50); do grep -q '^listening on' "$dir/fake.out" 2>/dev/null && break; sleep 0.1; done
 port=$(sed -n 's/^listening on 127\.0\.0\.1:\([0-9]*\).*/\1/p' "$dir/fake.out")
 [ -n "$port" ] || { echo "the fake middleware did not start"; cat "$dir/fake.out"; exit 1; }
-"$vrdeform" touch "$liver" --scale 0.001 --weart "127.0.0.1:$port" --seconds 2.5
+"$vrdeform" "$@" --weart "127.0.0.1:$port" --seconds 2.5
 kill -TERM $pid && wait $pid || true  # the fake flushes its log as it exits
 trap - EXIT
 echo "--- fake middleware log:"; cat "$dir/fake.log"
-grep -q 'force RIGHT INDEX 0\.[0-9]' "$dir/fake.log" || { echo "FAIL: no index force reached the glove"; exit 1; }
+grep -Eq 'force RIGHT (THUMB|INDEX|MIDDLE) 0\.[0-9]*[1-9]' "$dir/fake.log" || { echo "FAIL: no force reached the glove"; exit 1; }
 grep -q 'StopFromClient' "$dir/fake.log" || { echo "FAIL: no StopFromClient"; exit 1; }
 for point in THUMB INDEX MIDDLE; do
   last=$(grep -E "(force|stopForce) RIGHT $point" "$dir/fake.log" | tail -1)
