@@ -67,6 +67,30 @@ TEST_P(EveryScene, RunsTwoSecondsWithoutNaNKeepingItsVolume) {
   testing::record("index_force_max", r.forceMax[int(Finger::Index)]);
 }
 
+class EveryBody : public ::testing::TestWithParam<std::string> {};
+
+// The whole scripted interaction: the pinch of each tet body becomes a grasp, and the volume stays
+// within 1% through the poke, the grasp, the lift and the drop.
+TEST_P(EveryBody, WholeRunGraspsAndKeepsItsVolume) {
+  BuiltScene scene = buildScene(loadSceneByName(GetParam()));
+  RunSettings settings;
+  settings.steps = std::uint64_t(std::lround(scene.spec.seconds / scene.spec.solver.timeStep));
+  std::uint64_t grasped = 0;
+  settings.afterStep = [&](const RunStep& s) {
+    grasped += s.session->grasp().active();
+    return true;
+  };
+  const RunSummary r = runScene(scene, settings);
+  EXPECT_EQ(r.nanEvents, 0u);
+  EXPECT_LT(r.volumeLossMax, 0.01);
+  EXPECT_GT(grasped, 30u) << "the pinch should hold the body for at least half a second";
+  EXPECT_GT(r.forceMax[int(Finger::Thumb)], 0.1f);
+  testing::record("volume_loss_max", r.volumeLossMax);
+  testing::record("grasped_steps", double(grasped));
+}
+
+INSTANTIATE_TEST_SUITE_P(Builtin, EveryBody, ::testing::Values("balloon", "bear", "furball", "jelly", "liver"));
+
 INSTANTIATE_TEST_SUITE_P(Builtin, EveryScene,
                          ::testing::Values("balloon", "bear", "flag", "furball", "jelly", "liver"));
 
