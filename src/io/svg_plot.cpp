@@ -8,6 +8,7 @@
 #include <limits>
 #include <string_view>
 
+#include "io/xml_escape.h"
 #include "vrdeform/error.h"
 #include "vrdeform/io/write_file.h"
 
@@ -80,32 +81,6 @@ std::string tickLabel(double value, double step) {
   const int decimals = std::max(0, -int(std::floor(std::log10(step) + kTickEps)));
   if (decimals > 6 || std::abs(value) >= 1e7) return fmt::format("{:g}", value);
   return fmt::format("{:.{}f}", value, decimals);
-}
-
-/// Text for XML content and double-quoted attributes. Control characters other than tab and newline
-/// are not allowed in XML 1.0, so they are dropped.
-std::string escapeXml(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) >= 0x20 || c == '\t' || c == '\n' || c == '\r') out += c;
-    }
-  }
-  return out;
 }
 
 /// Characters (not bytes) of UTF-8 text, for sizing the legend.

@@ -19,6 +19,7 @@
 #include "io/tet_formats.h"
 #include "io/text_out.h"
 #include "io/text_tokens.h"
+#include "io/xml_escape.h"
 #include "vrdeform/error.h"
 
 namespace vrd::io {
@@ -356,29 +357,6 @@ class Reader {
 
 // ---- writing
 
-std::string escaped(std::string_view s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 struct OutArray {
   std::string name;
   const char* type;
@@ -463,7 +441,7 @@ void writeVtu(std::ostream& stream, std::span<const Vec3> points, std::span<cons
   TextOut out(stream);
   std::string appended;
   const auto dataArray = [&](const OutArray& a, int indent) {
-    out.print("{:{}}<DataArray type=\"{}\" Name=\"{}\"", "", indent, a.type, escaped(a.name));
+    out.print("{:{}}<DataArray type=\"{}\" Name=\"{}\"", "", indent, a.type, escapeXml(a.name));
     if (a.components != 1) out.print(" NumberOfComponents=\"{}\"", a.components);
     if (ascii) {
       out.print(" format=\"ascii\">\n{}{:{}}</DataArray>\n", a.ascii, "", indent);
@@ -506,7 +484,7 @@ void writeVtu(std::ostream& stream, std::span<const Vec3> points, std::span<cons
   out.print("  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", points.size(),
             tets.size());
   if (!pointArrays.empty()) {
-    out.print("      <PointData Vectors=\"{}\">\n", escaped(pointArrays[0].name));
+    out.print("      <PointData Vectors=\"{}\">\n", escapeXml(pointArrays[0].name));
     for (const OutArray& a : pointArrays) dataArray(a, 8);
     out.print("      </PointData>\n");
   }
