@@ -298,26 +298,26 @@ TEST(SceneFile, FullSceneSetsEveryField) {
   EXPECT_EQ(hand.script, "");
   ASSERT_EQ(hand.actions.size(), 2u);
   const ActionSpec& poke = hand.actions[0];
-  EXPECT_EQ(poke.kind, ActionKind::Poke);
+  EXPECT_EQ(poke.action.kind, ActionKind::Poke);
   EXPECT_EQ(poke.body, "liver");
-  EXPECT_EQ(poke.finger, Finger::Middle);
-  EXPECT_EQ(poke.start, 0.5);
-  EXPECT_EQ(poke.approach, 1.5);
-  EXPECT_EQ(poke.hold, 0.0);
-  EXPECT_EQ(poke.release, 0.75);
-  EXPECT_FLOAT_EQ(poke.depth, 0.02f);
+  EXPECT_EQ(poke.action.finger, Finger::Middle);
+  EXPECT_EQ(poke.action.start, 0.5);
+  EXPECT_EQ(poke.action.approach, 1.5);
+  EXPECT_EQ(poke.action.hold, 0.0);
+  EXPECT_EQ(poke.action.release, 0.75);
+  EXPECT_FLOAT_EQ(poke.action.depth, 0.02f);
   EXPECT_EQ(poke.offset, Vec3(0.01f, 0, -0.02f));
   const ActionSpec& grasp = hand.actions[1];
-  EXPECT_EQ(grasp.kind, ActionKind::Grasp);
+  EXPECT_EQ(grasp.action.kind, ActionKind::Grasp);
   EXPECT_EQ(grasp.body, "flag");
-  EXPECT_EQ(grasp.finger, Finger::Little);
-  EXPECT_EQ(grasp.start, 4.0);
-  EXPECT_EQ(grasp.approach, 2.0);
-  EXPECT_EQ(grasp.hold, 1.25);
-  EXPECT_EQ(grasp.release, 0.5);
-  EXPECT_FLOAT_EQ(grasp.depth, 0.005f);
-  EXPECT_FLOAT_EQ(grasp.width, 0.05f);
-  EXPECT_FLOAT_EQ(grasp.lift, 0.1f);
+  EXPECT_EQ(grasp.action.finger, Finger::Little);
+  EXPECT_EQ(grasp.action.start, 4.0);
+  EXPECT_EQ(grasp.action.approach, 2.0);
+  EXPECT_EQ(grasp.action.hold, 1.25);
+  EXPECT_EQ(grasp.action.release, 0.5);
+  EXPECT_FLOAT_EQ(grasp.action.depth, 0.005f);
+  EXPECT_FLOAT_EQ(grasp.action.width, 0.05f);
+  EXPECT_FLOAT_EQ(grasp.action.lift, 0.1f);
 
   const HapticSettings& h = s.haptics.settings;
   EXPECT_FALSE(s.haptics.calibrate);
@@ -381,10 +381,10 @@ TEST(SceneFile, AbsentKeysKeepTheirDefaults) {
   const ActionSpec& a = s.hand.actions[0];
   const ActionSpec da;
   EXPECT_EQ(a.body, "");
-  EXPECT_EQ(a.finger, Finger::Index);
-  EXPECT_EQ(a.start, da.start);
-  EXPECT_EQ(a.approach, da.approach);
-  EXPECT_EQ(a.depth, da.depth);
+  EXPECT_EQ(a.action.finger, Finger::Index);
+  EXPECT_EQ(a.action.start, da.action.start);
+  EXPECT_EQ(a.action.approach, da.action.approach);
+  EXPECT_EQ(a.action.depth, da.action.depth);
 
   EXPECT_TRUE(s.haptics.calibrate);
   EXPECT_EQ(s.haptics.settings.maxChangePerMs, HapticSettings().maxChangePerMs);
@@ -568,7 +568,8 @@ TEST(SceneFile, FingerTheHandLacks) {
   const std::string ring = "[[hand.action]]\ntype = \"poke\"\nfinger = \"ring\"\n";
   EXPECT_EQ(errorIn(std::string(kMinimal) + ring),
             "scene.toml:5: hand.action[1].finger: the g1 hand has no ring fingertip (model = \"pro\" has all five)");
-  EXPECT_EQ(parse(std::string(kMinimal) + "[hand]\nmodel = \"pro\"\n" + ring).hand.actions[0].finger, Finger::Ring);
+  EXPECT_EQ(parse(std::string(kMinimal) + "[hand]\nmodel = \"pro\"\n" + ring).hand.actions[0].action.finger,
+            Finger::Ring);
   EXPECT_EQ(errorIn(std::string(kMinimal) + "[[hand.action]]\ntype = \"grasp\"\nfinger = \"thumb\"\n"),
             "scene.toml:5: hand.action[1].finger: a grasp pairs the thumb with another finger; name that finger "
             "(index, middle, ring or little)");

@@ -203,16 +203,11 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log) {
 
   for (const ActionSpec& a : hand.actions) {
     const SceneBody& target = a.body.empty() ? scene.bodies.front() : scene.body(a.body);
-    HandAction action;
-    action.kind = a.kind;
-    action.finger = a.finger;
+    HandAction action = a.action;
     action.target = target.top;
     if (a.offset.x() != 0.0f || a.offset.z() != 0.0f)
       action.target = surfaceBelow(world, target.id, target.top + Vec3(a.offset.x(), 0.0f, a.offset.z()),
                                    2.0f * hand.rig.geometry.fingertipRadius);
-    action.start = a.start;
-    action.approach = a.approach, action.hold = a.hold, action.release = a.release;
-    action.depth = a.depth, action.width = a.width, action.lift = a.lift;
     scene.actions.push_back(action);
   }
   const float radius = hand.rig.geometry.fingertipRadius;

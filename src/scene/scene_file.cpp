@@ -560,8 +560,9 @@ ActionSpec readAction(const Table& t, const HandRigSettings& rig, std::string_vi
   static const Keys kGrasp = {"width", "lift"};
 
   ActionSpec a;
-  a.kind = t.require("type").choose(kKinds);
-  const bool poke = a.kind == ActionKind::Poke;
+  HandAction& h = a.action;
+  h.kind = t.require("type").choose(kKinds);
+  const bool poke = h.kind == ActionKind::Poke;
   t.allowOnly(poke ? kCommon : concat(kCommon, kGrasp), poke ? kGrasp : Keys{}, "a poke");
 
   if (std::optional<Field> f = t.get("body")) {
@@ -572,19 +573,19 @@ ActionSpec readAction(const Table& t, const HandRigSettings& rig, std::string_vi
       f->fail(fmt::format("no body named '{}' (the bodies: {})", printable(a.body), fmt::join(names, ", ")));
   }
   if (std::optional<Field> f = t.get("finger")) {
-    a.finger = f->choose(kFingers);
-    if (!poke && a.finger == Finger::Thumb)
+    h.finger = f->choose(kFingers);
+    if (!poke && h.finger == Finger::Thumb)
       f->fail("a grasp pairs the thumb with another finger; name that finger (index, middle, ring or little)");
-    if (!rig.fingers[int(a.finger)])
+    if (!rig.fingers[int(h.finger)])
       f->fail(fmt::format("the {} hand has no {} fingertip (model = \"pro\" has all five)", model, f->string()));
   }
-  t.readNumber("start", a.start, kNonNegative);
-  t.readNumber("approach", a.approach, kPositive);
-  t.readNumber("hold", a.hold, kNonNegative);
-  t.readNumber("release", a.release, kPositive);
-  t.readNumber("depth", a.depth, kNonNegative);
-  t.readNumber("width", a.width, kNonNegative);
-  t.readNumber("lift", a.lift, kNonNegative);
+  t.readNumber("start", h.start, kNonNegative);
+  t.readNumber("approach", h.approach, kPositive);
+  t.readNumber("hold", h.hold, kNonNegative);
+  t.readNumber("release", h.release, kPositive);
+  t.readNumber("depth", h.depth, kNonNegative);
+  t.readNumber("width", h.width, kNonNegative);
+  t.readNumber("lift", h.lift, kNonNegative);
   t.readVec3("offset", a.offset);
   return a;
 }

@@ -43,23 +43,14 @@ struct BodySpec {
   Vec3 force = Vec3::Zero();  ///< constant force on every particle (N); the scene's wind adds to cloth
 };
 
-/// One scripted action of the hand on a body, timed from the end of the settling phase.
-/// Poke: a fingertip (`finger`) comes down on the body's top to `depth` below it in `approach` s,
-/// holds `hold` s and withdraws in `release` s. Grasp: thumb and `finger` come down on both sides of
-/// the top `width` apart to `depth` below it, close to pinch the body in `approach` s, lift it by
-/// `lift` (m) while holding `hold` s, put it back and open in `release` s.
+/// One scripted action of the hand (hand_actions.h) on a body, timed from the end of the settling
+/// phase and aimed at where that body came to rest.
 struct ActionSpec {
-  ActionKind kind = ActionKind::Poke;
   std::string body;  ///< empty: the first body
-  Finger finger = Finger::Index;
-  double start = 0.0;  ///< s after settling
-  double approach = 1.0, hold = 1.0, release = 1.0;
-  float depth = 0.01f;  ///< m below the top: the poke's deepest point, the grasp's fingertips
-  float width = 0.0f;   ///< grasp: opening before closing (m); 0: the body's width at the top, capped
-  float lift = 0.0f;    ///< grasp: m
   /// Moves the target from the body's top along x and z (m), down to the highest particle within two
   /// fingertip radii of that vertical (where a fingertip coming down meets the body); y is unused.
   Vec3 offset = Vec3::Zero();
+  HandAction action;  ///< its target is set when the scene is built
 };
 
 struct HandSpec {
