@@ -37,8 +37,7 @@ void check(const HandAction& a, std::size_t index) {
     fail("a grasp pinches the thumb against another finger");
 }
 
-}  // namespace
-
+// Fingertip centres of action `a` at time t: the acting ones placed, the others parked.
 HandFrame actionFrame(const HandAction& a, float r, double t) {
   HandFrame f = parked(a.target);
   // Height of a fingertip's centre whose lowest point is `depth` below the target.
@@ -77,6 +76,8 @@ HandFrame actionFrame(const HandAction& a, float r, double t) {
   f.fingertips[int(a.finger)] = Vec3(a.target.x() + half, y, a.target.z());
   return f;
 }
+
+}  // namespace
 
 HandActionsInput::HandActionsInput(std::vector<HandAction> actions, float fingertipRadius)
     : actions_(std::move(actions)), radius_(fingertipRadius) {

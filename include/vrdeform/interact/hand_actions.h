@@ -47,7 +47,4 @@ class HandActionsInput final : public HandInput {
   float radius_;
 };
 
-/// Fingertip centres of `action` at `time` (the acting ones; others as `parked`).
-HandFrame actionFrame(const HandAction& action, float fingertipRadius, double time);
-
 }  // namespace vrd
