@@ -204,7 +204,7 @@ int run(const RunArgs& a) {
   printSummary(summary, scene);
   if (!summary.files.empty()) {
     fmt::print("\nwrote into {}:", a.out);
-    for (const auto& f : summary.files) fmt::print(" {}", f.filename().string());
+    for (const auto& f : summary.files) fmt::print(" {}", f.generic_string());
     fmt::print("\n");
   }
   return 0;

@@ -133,6 +133,31 @@ TEST(SceneRun, WritesEveryOutputAndASummaryWithTheDocumentedKeys) {
   EXPECT_EQ(rows, 150u);
 }
 
+TEST(SceneRun, WritesClothAndRenderMeshesToo) {
+  const testing::TempDir dir;
+  for (const char* name : {"flag", "bear"}) {
+    SceneSpec spec = loadSceneByName(name);
+    spec.settle = 0.0;
+    spec.haptics.calibrate = false;
+    BuiltScene scene = buildScene(spec);
+    RunSettings settings;
+    settings.steps = 12;  // mesh frames every 0.1 s: 2
+    settings.outDir = dir.path() / name;
+    const RunSummary r = runScene(scene, settings);
+    EXPECT_NE(std::find(r.files.begin(), r.files.end(), std::filesystem::path("meshes") / (std::string(name) + ".pvd")),
+              r.files.end());
+  }
+  const auto points = [](const std::filesystem::path& vtu) {
+    std::ifstream in(vtu);
+    std::string head(400, '\0');
+    in.read(head.data(), 400);
+    const std::size_t at = head.find("NumberOfPoints=\"");
+    return at == std::string::npos ? -1 : std::stol(head.substr(at + 16));
+  };
+  EXPECT_EQ(points(dir.path() / "flag" / "meshes" / "flag_00001.vtu"), 841);           // the cloth's particles
+  EXPECT_EQ(points(dir.path() / "bear" / "meshes" / "bear_render_00001.vtu"), 13826);  // bear.obj, carried by the tets
+}
+
 TEST(SceneRun, AFailedRunStillLeavesASummarySayingSo) {
   const testing::TempDir dir;
   SceneSpec spec = loadSceneByName("jelly");

@@ -717,6 +717,29 @@ TEST(VtuSequence, DisplacementIsPositionMinusRest) {
   }
 }
 
+TEST(VtuSequence, SurfacesAreWrittenAsTriangleCells) {
+  TempDir dir;
+  const TriMesh cloth{{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0)}, {{0, 1, 2}, {1, 3, 2}}};
+  TetWriteOptions ascii;
+  ascii.vtuEncoding = VtuEncoding::Ascii;
+  VtuSequence sequence(dir / "cloth.pvd", cloth, ascii);
+  std::vector<Vec3> moved = cloth.vertices;
+  moved[3].z() = 0.5f;
+  sequence.addFrame(0.1, moved);
+  const std::string vtu = readBytes(sequence.framePath(0));
+  EXPECT_NE(vtu.find("NumberOfPoints=\"4\" NumberOfCells=\"2\""), std::string::npos) << vtu;
+  const auto array = [&](const char* name) {  // the text of an ASCII DataArray
+    const std::size_t at = vtu.find(std::string("Name=\"") + name + "\"");
+    const std::size_t begin = vtu.find('>', at) + 1;
+    return vtu.substr(begin, vtu.find("</DataArray>", begin) - begin);
+  };
+  EXPECT_EQ(array("connectivity"), "\n0 1 2\n1 3 2\n        ");
+  EXPECT_EQ(array("offsets"), "\n3\n6\n        ");
+  EXPECT_EQ(array("types"), "\n5\n5\n        ");  // VTK_TRIANGLE
+  EXPECT_NE(array("displacement").find("0 0 0.5"), std::string::npos);
+  EXPECT_ERROR_MENTIONS(VtuSequence(dir / "empty.pvd", TriMesh{}), "no triangles");
+}
+
 // ---- boundaryFaces
 
 TEST(WriteFile, WholeOrNothing) {

@@ -31,7 +31,9 @@ struct VtuPointArray {
   std::string_view name;
   std::span<const Vec3> values;
 };
-void writeVtu(std::ostream& out, std::span<const Vec3> points, std::span<const Tet> tets,
+/// Writes the points with `cells` as VTK tetrahedra (N = 4) or triangles (N = 3).
+template <std::size_t N>
+void writeVtu(std::ostream& out, std::span<const Vec3> points, std::span<const std::array<Index, N>> cells,
               std::span<const VtuPointArray> pointData, const TetWriteOptions& options);
 
 /// Checks what every reader promises: tets present, finite coordinates, at most 2^32 - 1 vertices.

@@ -83,7 +83,7 @@ void writeTetMesh(const std::filesystem::path& path, const TetMesh& mesh, const 
   } else if (ext == ".vtk") {
     io::writeVtkLegacy(file.stream(), mesh);
   } else {
-    io::writeVtu(file.stream(), mesh.vertices, mesh.tets, {}, options);
+    io::writeVtu<4>(file.stream(), mesh.vertices, mesh.tets, {}, options);
   }
   file.commit();
 }

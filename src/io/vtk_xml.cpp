@@ -398,8 +398,11 @@ TetMesh readVtu(std::string_view text, const std::string& name, std::vector<Tria
   return Reader(text, name).read(faces);
 }
 
-void writeVtu(std::ostream& stream, std::span<const Vec3> points, std::span<const Tet> tets,
+template <std::size_t N>
+void writeVtu(std::ostream& stream, std::span<const Vec3> points, std::span<const std::array<Index, N>> cells,
               std::span<const VtuPointArray> pointData, const TetWriteOptions& options) {
+  static_assert(N == 3 || N == 4);
+  constexpr int kType = N == 4 ? 10 : 5;  // VTK_TETRA, VTK_TRIANGLE
   const bool ascii = options.vtuEncoding == VtuEncoding::Ascii;
   const bool compress = options.vtuCompress && !ascii;
   const auto vectors = [&](std::string_view name, std::span<const Vec3> values) {
@@ -423,18 +426,18 @@ void writeVtu(std::ostream& stream, std::span<const Vec3> points, std::span<cons
       types{"types", "UInt8", 1, {}, {}};
   if (ascii) {
     fmt::memory_buffer c, o;
-    for (std::size_t t = 0; t < tets.size(); ++t) {
-      fmt::format_to(std::back_inserter(c), "{} {} {} {}\n", tets[t][0], tets[t][1], tets[t][2], tets[t][3]);
-      fmt::format_to(std::back_inserter(o), "{}\n", 4 * (t + 1));
+    for (std::size_t t = 0; t < cells.size(); ++t) {
+      fmt::format_to(std::back_inserter(c), "{}\n", fmt::join(cells[t], " "));
+      fmt::format_to(std::back_inserter(o), "{}\n", N * (t + 1));
+      types.ascii += fmt::format("{}\n", kType);
     }
     connectivity.ascii = fmt::to_string(c);
     offsets.ascii = fmt::to_string(o);
-    for (std::size_t t = 0; t < tets.size(); ++t) types.ascii += "10\n";
   } else {
-    for (std::size_t t = 0; t < tets.size(); ++t) {
-      for (Index i : tets[t]) storeLittle<std::int64_t>(connectivity.bytes, i);
-      storeLittle<std::int64_t>(offsets.bytes, static_cast<std::int64_t>(4 * (t + 1)));
-      storeLittle<std::uint8_t>(types.bytes, 10);
+    for (std::size_t t = 0; t < cells.size(); ++t) {
+      for (Index i : cells[t]) storeLittle<std::int64_t>(connectivity.bytes, i);
+      storeLittle<std::int64_t>(offsets.bytes, static_cast<std::int64_t>(N * (t + 1)));
+      storeLittle<std::uint8_t>(types.bytes, kType);
     }
   }
 
@@ -482,7 +485,7 @@ void writeVtu(std::ostream& stream, std::span<const Vec3> points, std::span<cons
       "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\"{}>\n",
       compress ? " compressor=\"vtkZLibDataCompressor\"" : "");
   out.print("  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", points.size(),
-            tets.size());
+            cells.size());
   if (!pointArrays.empty()) {
     out.print("      <PointData Vectors=\"{}\">\n", escapeXml(pointArrays[0].name));
     for (const OutArray& a : pointArrays) dataArray(a, 8);
@@ -506,5 +509,10 @@ void writeVtu(std::ostream& stream, std::span<const Vec3> points, std::span<cons
   }
   out.print("</VTKFile>\n");
 }
+
+template void writeVtu<3>(std::ostream&, std::span<const Vec3>, std::span<const Triangle>,
+                          std::span<const VtuPointArray>, const TetWriteOptions&);
+template void writeVtu<4>(std::ostream&, std::span<const Vec3>, std::span<const Tet>, std::span<const VtuPointArray>,
+                          const TetWriteOptions&);
 
 }  // namespace vrd::io

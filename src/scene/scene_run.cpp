@@ -50,9 +50,18 @@ class RunFiles {
       fs::create_directories(dir / "meshes", ec);
       if (ec) throw Error(fmt::format("{}: cannot create the folder: {}", (dir / "meshes").string(), ec.message()));
       meshEvery_ = std::max<std::uint64_t>(1, std::uint64_t(std::llround(every / scene.spec.solver.timeStep)));
-      for (const SceneBody& b : scene.bodies)
+      // Each body (tets, or a cloth's triangles), and a render mesh driven by a body's tets.
+      const auto add = [&](const SceneBody& b, std::string name, auto mesh, bool render) {
+        name += ".pvd";
+        meshes_.push_back({&b, render, name, std::make_unique<VtuSequence>(dir / "meshes" / name, std::move(mesh))});
+      };
+      for (const SceneBody& b : scene.bodies) {
         if (b.kind == BodyKind::Soft)
-          meshes_.push_back({&b, std::make_unique<VtuSequence>(dir / "meshes" / (b.name + ".pvd"), b.mesh.tets)});
+          add(b, b.name, b.mesh.tets, false);
+        else
+          add(b, b.name, b.mesh.surface, false);
+        if (b.embedding) add(b, b.name + "_render", b.mesh.render, true);
+      }
     }
   }
 
@@ -63,11 +72,17 @@ class RunFiles {
     for (double ms : times.ms) stageCsv_ += fmt::format(",{:.5f}", ms);
     stageCsv_ += fmt::format(",{:.5f}\n", times.totalMs());
     if (meshEvery_ > 0 && (k + 1) % meshEvery_ == 0) {
-      for (auto& [body, sequence] : meshes_) {
-        const Body& b = scene.world->body(body->id);
-        positions_.resize(b.particleCount);
-        for (Index i = 0; i < b.particleCount; ++i) positions_[i] = scene.world->particles().x[b.firstParticle + i].pos;
-        sequence->addFrame(t, positions_);
+      for (Meshes& m : meshes_) {
+        const Body& b = scene.world->body(m.body->id);
+        const std::span<const Point> points(scene.world->particles().x.data() + b.firstParticle, b.particleCount);
+        if (m.render) {
+          positions_.resize(m.body->embedding->vertexCount());
+          m.body->embedding->update(points, std::span<Vec3>(positions_), {});
+        } else {
+          positions_.resize(points.size());
+          for (std::size_t i = 0; i < points.size(); ++i) positions_[i] = points[i].pos;
+        }
+        m.sequence->addFrame(t, positions_);
       }
     }
   }
@@ -77,19 +92,19 @@ class RunFiles {
               const std::array<std::vector<double>, kFingerCount>& force, const std::vector<double>& paper,
               const std::array<PlotSeries, kFingerCount>& indentation, std::vector<fs::path>& files) {
     forces_.reset();  // flushes and closes
-    files.push_back(dir_ / "forces.csv");
+    files.push_back("forces.csv");
     writeFile(dir_ / "stage_times.csv", stageCsv_);
-    files.push_back(dir_ / "stage_times.csv");
+    files.push_back("stage_times.csv");
     writeFile(dir_ / "latency.csv", latencyCsv(summary.latency));
-    files.push_back(dir_ / "latency.csv");
-    for (const auto& m : meshes_) files.push_back(dir_ / "meshes" / (m.body->name + ".pvd"));
+    files.push_back("latency.csv");
+    for (const Meshes& m : meshes_) files.push_back(fs::path("meshes") / m.file);
 
     Plot overTime{fmt::format("{}: haptic force", summary.scene), "time (s)", "force (normalised)", {}, {{0.0, 1.0}}};
     for (int f = 0; f < kFingerCount; ++f)
       if (fingers_[f]) overTime.series.push_back({std::string(fingerName(Finger(f))), time, force[f]});
     overTime.series.push_back({"hand (Algorithm 2)", time, paper});
     writeSvgPlot(dir_ / "force_time.svg", overTime);
-    files.push_back(dir_ / "force_time.svg");
+    files.push_back("force_time.svg");
 
     Plot overDepth{fmt::format("{}: force against indentation (pokes)", summary.scene),
                    "indentation (mm)",
@@ -100,13 +115,15 @@ class RunFiles {
       if (!s.x.empty()) overDepth.series.push_back(s);
     if (!overDepth.series.empty()) {
       writeSvgPlot(dir_ / "force_indentation.svg", overDepth);
-      files.push_back(dir_ / "force_indentation.svg");
+      files.push_back("force_indentation.svg");
     }
   }
 
  private:
   struct Meshes {
     const SceneBody* body;
+    bool render;       // the body's render mesh, else the body itself
+    std::string file;  // in meshes/
     std::unique_ptr<VtuSequence> sequence;
   };
   fs::path dir_;
@@ -217,7 +234,7 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
     std::error_code ec;
     fs::create_directories(settings.outDir, ec);  // a failed run may not have made it
     writeFile(settings.outDir / "summary.json", summaryJson(summary));
-    summary.files.push_back(settings.outDir / "summary.json");
+    summary.files.push_back("summary.json");
   }
   if (!summary.ok) throw Error(summary.error);
   return summary;
@@ -263,7 +280,7 @@ std::string summaryJson(const RunSummary& s) {
   j["events"] = s.events;
   j["wall_seconds"] = s.wallSeconds;
   json files = json::array();
-  for (const auto& f : s.files) files.push_back(f.filename().string());
+  for (const auto& f : s.files) files.push_back(f.generic_string());
   j["files"] = files;
   return j.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
 }

@@ -18,6 +18,8 @@ class VtuSequence {
   /// the rest positions that displacements are measured from. `options`: the .vtu encoding (default:
   /// appended raw binary, as ParaView writes). Throws vrd::Error.
   VtuSequence(std::filesystem::path pvdPath, TetMesh restMesh, TetWriteOptions options = {});
+  /// The same for a deforming surface (a cloth, a render mesh): its triangles are the cells.
+  VtuSequence(std::filesystem::path pvdPath, TriMesh restSurface, TetWriteOptions options = {});
 
   /// Writes the next frame: `positions` (one per rest vertex, finite) as the points, with point data
   /// `displacement` = positions - rest; then rewrites the .pvd atomically, so it is valid after every
@@ -36,7 +38,9 @@ class VtuSequence {
     std::string file;  // relative to the .pvd
   };
   std::filesystem::path pvdPath_;
-  TetMesh rest_;
+  std::vector<Vec3> restPoints_;
+  std::vector<Tet> tets_;            // the cells: tets, or
+  std::vector<Triangle> triangles_;  // triangles
   TetWriteOptions options_;
   std::vector<Frame> frames_;
   std::vector<Vec3> displacement_;

@@ -52,7 +52,7 @@ struct RunSummary {
   double wallSeconds = 0.0;
   bool ok = false;
   std::string error;
-  std::vector<std::filesystem::path> files;  ///< written into outDir
+  std::vector<std::filesystem::path> files;  ///< written into outDir, relative to it
 };
 
 /// Runs the scene. With an outDir, writes every output there (creating the folder) and
