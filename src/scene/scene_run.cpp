@@ -33,6 +33,27 @@ std::map<std::string, std::size_t> constraintCounts(const std::vector<SceneBody>
   return n;
 }
 
+// Per-step series for the plots: the force of each finger and of the hand against time, and during
+// pokes the poking finger's force against its depth below the target.
+struct Traces {
+  std::vector<double> time, paper;
+  std::array<std::vector<double>, kFingerCount> force;
+  std::array<PlotSeries, kFingerCount> indentation;
+
+  Traces() {
+    for (int f = 0; f < kFingerCount; ++f) indentation[f].label = std::string(fingerName(Finger(f)));
+  }
+  void add(double t, const HapticFrame& h, const HandRig& rig, const HandAction* poke) {
+    time.push_back(t);
+    paper.push_back(h.paper);
+    for (int f = 0; f < kFingerCount; ++f) force[f].push_back(h.fingers[f].force);
+    if (!poke) return;
+    const float tipLow = rig.target(poke->finger).y() - rig.settings().geometry.fingertipRadius;
+    indentation[int(poke->finger)].x.push_back(1e3 * std::max(0.0f, poke->target.y() - tipLow));
+    indentation[int(poke->finger)].y.push_back(h.fingers[int(poke->finger)].newtons);
+  }
+};
+
 // The files of a run with an outDir; each output only exists when it applies.
 class RunFiles {
  public:
@@ -65,9 +86,10 @@ class RunFiles {
     }
   }
 
-  void step(const BuiltScene& scene, const HapticSession& session, std::uint64_t k, double t, bool contact) {
-    forces_->send(sampleOf(t, session.haptics(), fingers_));
-    const StageTimes& times = session.times();
+  // One step; `session` is null in a scene without a hand (the force trace then stays empty).
+  void step(const BuiltScene& scene, const HapticSession* session, const StageTimes& times, std::uint64_t k, double t,
+            bool contact) {
+    if (session) forces_->send(sampleOf(t, session->haptics(), fingers_));
     stageCsv_ += fmt::format("{},{:.6f},{}", k, t, contact ? "contact" : "idle");
     for (double ms : times.ms) stageCsv_ += fmt::format(",{:.5f}", ms);
     stageCsv_ += fmt::format(",{:.5f}\n", times.totalMs());
@@ -88,9 +110,7 @@ class RunFiles {
   }
 
   // Everything but summary.json; the plots from the per-step traces.
-  void finish(const RunSummary& summary, const std::vector<double>& time,
-              const std::array<std::vector<double>, kFingerCount>& force, const std::vector<double>& paper,
-              const std::array<PlotSeries, kFingerCount>& indentation, std::vector<fs::path>& files) {
+  void finish(const RunSummary& summary, const Traces& traces, std::vector<fs::path>& files) {
     forces_.reset();  // flushes and closes
     files.push_back("forces.csv");
     writeFile(dir_ / "stage_times.csv", stageCsv_);
@@ -101,8 +121,8 @@ class RunFiles {
 
     Plot overTime{fmt::format("{}: haptic force", summary.scene), "time (s)", "force (normalised)", {}, {{0.0, 1.0}}};
     for (int f = 0; f < kFingerCount; ++f)
-      if (fingers_[f]) overTime.series.push_back({std::string(fingerName(Finger(f))), time, force[f]});
-    overTime.series.push_back({"hand (Algorithm 2)", time, paper});
+      if (fingers_[f]) overTime.series.push_back({std::string(fingerName(Finger(f))), traces.time, traces.force[f]});
+    overTime.series.push_back({"hand (Algorithm 2)", traces.time, traces.paper});
     writeSvgPlot(dir_ / "force_time.svg", overTime);
     files.push_back("force_time.svg");
 
@@ -111,7 +131,7 @@ class RunFiles {
                    "force (N)",
                    {},
                    std::nullopt};
-    for (const PlotSeries& s : indentation)
+    for (const PlotSeries& s : traces.indentation)
       if (!s.x.empty()) overDepth.series.push_back(s);
     if (!overDepth.series.empty()) {
       writeSvgPlot(dir_ / "force_indentation.svg", overDepth);
@@ -158,15 +178,11 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
   summary.latency.reserve(std::size_t(std::min<std::uint64_t>(settings.steps, 1u << 22)));
 
   std::unique_ptr<RunFiles> files;
-  std::vector<double> time, paper;
-  std::array<std::vector<double>, kFingerCount> force;
-  std::array<PlotSeries, kFingerCount> indentation;
-  for (int f = 0; f < kFingerCount; ++f) indentation[f].label = std::string(fingerName(Finger(f)));
+  Traces traces;
 
   HandInput* input = settings.input ? settings.input : scene.input.get();
   std::optional<HapticSession> session;
   if (scene.spec.hand.enabled) session.emplace(world, scene.session, input ? input->frame(0, 0.0) : HandFrame{});
-  const float radius = scene.session.hand.geometry.fingertipRadius;
   const auto start = std::chrono::steady_clock::now();
   try {
     if (!settings.outDir.empty()) files = std::make_unique<RunFiles>(scene, settings.outDir, summary.fingers);
@@ -180,7 +196,7 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
       } else {
         world.step();
       }
-      StageTimes times = session ? session->times() : world.lastStep().times;
+      const StageTimes& times = session ? session->times() : world.lastStep().times;
       summary.latency.add(times, contact);
       for (const SimEvent& e : world.takeEvents()) {
         ++summary.nanEvents;
@@ -198,22 +214,15 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
         const HapticSample sample = sampleOf(t, h, summary.fingers);
         for (HapticOutput* out : settings.outputs) out->send(sample);
         summary.paperMax = std::max(summary.paperMax, h.paper);
-        time.push_back(t);
-        paper.push_back(h.paper);
         for (int f = 0; f < kFingerCount; ++f) {
           summary.forceMax[f] = std::max(summary.forceMax[f], h.fingers[f].force);
           summary.newtonsMax[f] = std::max(summary.newtonsMax[f], h.fingers[f].newtons);
-          force[f].push_back(h.fingers[f].force);
         }
-        if (const HandAction* poke =
-                input == scene.input.get() ? pokeAt(scene.actions, double(k) * summary.dt) : nullptr) {
-          const float tipLow = session->rig().target(poke->finger).y() - radius;
-          PlotSeries& s = indentation[int(poke->finger)];
-          s.x.push_back(1e3 * std::max(0.0f, poke->target.y() - tipLow));
-          s.y.push_back(h.fingers[int(poke->finger)].newtons);
-        }
-        if (files) files->step(scene, *session, k, t, contact);
+        // Indentation only for the scene's own pokes (a glove's hand has no target).
+        const bool scripted = input == scene.input.get();
+        traces.add(t, h, session->rig(), scripted ? pokeAt(scene.actions, double(k) * summary.dt) : nullptr);
       }
+      if (files) files->step(scene, session ? &*session : nullptr, times, k, t, contact);
       if (settings.afterStep && !settings.afterStep(RunStep{k, t, session ? &*session : nullptr, loss})) break;
     }
     summary.ok = true;
@@ -224,7 +233,7 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
   summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (files && summary.ok) {
     try {
-      files->finish(summary, time, force, paper, indentation, summary.files);
+      files->finish(summary, traces, summary.files);
     } catch (const std::exception& e) {
       summary.ok = false;
       summary.error = e.what();
