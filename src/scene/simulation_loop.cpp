@@ -1,0 +1,218 @@
+#include "vrdeform/scene/simulation_loop.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "vrdeform/error.h"
+
+namespace vrd {
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+SimulationLoop::SimulationLoop(BuiltScene& scene, SimulationLoopSettings settings)
+    : scene_(scene), settings_(std::move(settings)) {
+  World& world = *scene_.world;
+  dt_ = double(world.settings().timeStep);
+  if (!(dt_ >= 0.999e-4 && dt_ <= 1.0))
+    throw Error(fmt::format("simulation loop: the scene's rate {:g} Hz is outside [1, 10000]", 1.0 / dt_));
+  input_ = settings_.input ? settings_.input : scene_.input.get();
+  if (scene_.spec.hand.enabled) session_.emplace(world, scene_.session, input_ ? input_->frame(0, 0.0) : HandFrame{});
+  particles_ = world.particles().size();
+  bodies_ = world.bodyCount();
+  std::size_t frames = settings_.latencyFrames;
+  if (settings_.maxSteps > 0) frames = std::size_t(std::min<std::uint64_t>(frames, settings_.maxSteps));
+  latency_.reserve(frames);
+  stepMs_.reserve(frames);
+}
+
+SimulationLoop::~SimulationLoop() {
+  try {
+    stop();
+  } catch (...) {  // a destructor must not throw; error() had it
+  }
+}
+
+void SimulationLoop::start() {
+  if (started_ || stopRequested_.load()) throw Error("simulation loop: start() after start() or stop()");
+  started_ = true;
+  running_.store(true, std::memory_order_release);
+  try {
+    thread_ = std::thread([this] { run(); });
+  } catch (...) {
+    running_.store(false, std::memory_order_release);
+    throw;
+  }
+}
+
+void SimulationLoop::stop() {
+  {
+    // Under the sleep mutex, so a loop about to sleep either sees the request or gets the notify.
+    std::lock_guard lock(sleepMutex_);
+    stopRequested_.store(true, std::memory_order_release);
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+  if (error_ && !errorReported_) {
+    errorReported_ = true;
+    std::rethrow_exception(error_);
+  }
+}
+
+std::exception_ptr SimulationLoop::error() const { return thread_.joinable() ? nullptr : error_; }
+
+void SimulationLoop::requireStopped(const char* what) const {
+  if (thread_.joinable())
+    throw Error(fmt::format("simulation loop: {} read while the loop runs; stop() it first", what));
+}
+
+const LatencyRecorder& SimulationLoop::latency() const {
+  requireStopped("latency()");
+  return latency_;
+}
+
+LoopStats SimulationLoop::stats() const {
+  requireStopped("stats()");
+  LoopStats s;
+  s.steps = steps();
+  s.overruns = overruns();
+  s.resyncs = resyncs_;
+  if (s.steps > 0) s.wallSeconds = std::chrono::duration<double>(end_ - firstStart_).count();
+  const double span = std::chrono::duration<double>(lastStart_ - firstStart_).count();
+  if (s.steps > 1 && span > 0.0) s.achievedRate = double(s.steps - 1) / span;
+  s.stepMs = summarise(stepMs_);
+  return s;
+}
+
+std::shared_ptr<SnapshotChannel> SimulationLoop::subscribe() {
+  auto channel = std::make_shared<SnapshotChannel>(particles_, bodies_);
+  std::lock_guard lock(channelsMutex_);
+  wanted_.push_back(channel);
+  channelsChanged_.store(true, std::memory_order_release);
+  return channel;
+}
+
+void SimulationLoop::unsubscribe(const std::shared_ptr<SnapshotChannel>& channel) {
+  std::lock_guard lock(channelsMutex_);
+  std::erase(wanted_, channel);
+  channelsChanged_.store(true, std::memory_order_release);
+}
+
+void SimulationLoop::pickUpChannels() {
+  if (!channelsChanged_.load(std::memory_order_acquire)) return;
+  std::unique_lock lock(channelsMutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return;  // a subscriber holds it: try again next step
+  channels_ = wanted_;
+  channelsChanged_.store(false, std::memory_order_relaxed);
+}
+
+void SimulationLoop::run() {
+  const double periodMs = 1e3 * period();
+  Clock::time_point origin = Clock::now();  // of the real-time schedule
+  std::uint64_t sinceOrigin = 0;            // steps started since origin
+  firstStart_ = lastStart_ = origin;
+  try {
+    for (std::uint64_t k = 0; settings_.maxSteps == 0 || k < settings_.maxSteps; ++k) {
+      if (k > 0 && settings_.realTime) pace(origin, sinceOrigin);
+      if (stopRequested_.load(std::memory_order_acquire)) break;
+      lastStart_ = Clock::now();
+      if (k == 0) firstStart_ = origin = lastStart_;
+      pickUpChannels();
+      step(k);
+      publish(k, msSince(lastStart_));
+      const double workMs = msSince(lastStart_);
+      if (stepMs_.size() < settings_.latencyFrames) stepMs_.push_back(workMs);
+      if (workMs > periodMs) overruns_.fetch_add(1, std::memory_order_relaxed);
+      steps_.store(k + 1, std::memory_order_release);
+    }
+  } catch (...) {
+    error_ = std::current_exception();
+  }
+  // A glove must not stay pressing, whatever ended the loop.
+  for (HapticOutput* out : settings_.outputs) {
+    try {
+      out->release();
+    } catch (...) {
+      if (!error_) error_ = std::current_exception();
+    }
+  }
+  end_ = Clock::now();
+  running_.store(false, std::memory_order_release);
+}
+
+void SimulationLoop::step(std::uint64_t k) {
+  World& world = *scene_.world;
+  if (session_) {
+    session_->step(input_ ? input_->frame(k, double(k) * dt_) : HandFrame{});
+    contact_ = session_->grasp().active();
+    for (const FingerHaptics& f : session_->haptics().fingers) contact_ = contact_ || f.contacts > 0;
+    const HapticSample sample = sampleOf(double(k + 1) * dt_, session_->haptics(), scene_.session.hand.fingers);
+    for (HapticOutput* out : settings_.outputs) out->send(sample);
+  } else {
+    world.step();
+    contact_ = false;
+  }
+  if (k < settings_.latencyFrames) latency_.add(session_ ? session_->times() : world.lastStep().times, contact_);
+}
+
+void SimulationLoop::publish(std::uint64_t k, double stepWallMs) {
+  for (const std::shared_ptr<SnapshotChannel>& channel : channels_) {
+    fill(channel->back(), k, stepWallMs);
+    channel->publish();
+  }
+}
+
+void SimulationLoop::fill(Snapshot& s, std::uint64_t k, double stepWallMs) const {
+  const World& world = *scene_.world;
+  s.step = k + 1;
+  s.time = double(k + 1) * dt_;
+  const std::vector<Point>& x = world.particles().x;
+  s.positions.resize(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) s.positions[i] = x[i].pos;
+  s.bodyFirst.resize(world.bodyCount());
+  for (std::size_t b = 0; b < s.bodyFirst.size(); ++b) s.bodyFirst[b] = world.body(BodyId(b)).firstParticle;
+  s.fingerPresent = {};
+  s.fingertips.fill(Vec3::Zero());
+  s.fingertipRadius = 0.0f;
+  if (session_) {
+    const HandRig& rig = session_->rig();
+    for (int f = 0; f < kFingerCount; ++f)
+      if (rig.has(Finger(f))) {
+        s.fingerPresent[f] = true;
+        s.fingertips[f] = world.fingertip(rig.fingertip(Finger(f))).center;
+      }
+    s.fingertipRadius = scene_.session.hand.geometry.fingertipRadius;
+    s.haptics = session_->haptics();
+    s.grasping = session_->grasp().active();
+  } else {
+    s.haptics = {};
+    s.grasping = false;
+  }
+  s.contact = contact_;
+  s.times = session_ ? session_->times() : world.lastStep().times;
+  s.stepWallMs = stepWallMs;
+}
+
+void SimulationLoop::pace(Clock::time_point& origin, std::uint64_t& sinceOrigin) {
+  // Deadlines from an absolute schedule (origin + n periods, rounded once each): no drift.
+  ++sinceOrigin;
+  const Clock::time_point deadline = origin + std::chrono::nanoseconds(std::llround(double(sinceOrigin) * 1e9 * dt_));
+  const Clock::time_point now = Clock::now();
+  if (now - deadline > std::chrono::duration<double>(kMaxLagPeriods * period())) {
+    origin = now;  // too far behind: start the schedule again rather than burst to catch up
+    sinceOrigin = 0;
+    ++resyncs_;
+    return;
+  }
+  std::unique_lock lock(sleepMutex_);
+  wake_.wait_until(lock, deadline, [this] { return stopRequested_.load(std::memory_order_relaxed); });
+}
+
+}  // namespace vrd
