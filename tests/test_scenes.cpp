@@ -85,6 +85,9 @@ TEST_P(EveryBody, WholeRunGraspsAndKeepsItsVolume) {
   EXPECT_LT(r.volumeLossMax, 0.01);
   EXPECT_GT(grasped, 30u) << "the pinch should hold the body for at least half a second";
   EXPECT_GT(r.forceMax[int(Finger::Thumb)], 0.1f);
+  // Table 3's two states: the hand touches during the poke and the grasp, and is idle between.
+  EXPECT_GE(r.latency.frames(Phase::Contact), grasped);
+  EXPECT_GT(r.latency.frames(Phase::Idle), 60u);
   testing::record("volume_loss_max", r.volumeLossMax);
   testing::record("grasped_steps", double(grasped));
 }

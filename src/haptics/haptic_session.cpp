@@ -37,6 +37,13 @@ std::uint64_t HapticSession::run(HandInput& input, std::uint64_t maxSteps, Sessi
   return done;
 }
 
+bool HapticSession::inContact() const {
+  if (grasp_.active()) return true;
+  for (const FingerHaptics& f : haptics().fingers)
+    if (f.contacts > 0) return true;
+  return false;
+}
+
 std::vector<float> recordedOutputs(const HapticFrame& frame) {
   std::vector<float> out{frame.paper, frame.paperRaw};
   for (const FingerHaptics& f : frame.fingers) out.insert(out.end(), {f.force, f.raw, f.newtons, f.baseline});

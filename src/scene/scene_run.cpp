@@ -191,8 +191,7 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
       bool contact = false;
       if (session) {
         session->step(input ? input->frame(k, double(k) * summary.dt) : HandFrame{});
-        contact = session->grasp().active();
-        for (const FingerHaptics& f : session->haptics().fingers) contact = contact || f.contacts > 0;
+        contact = session->inContact();
       } else {
         world.step();
       }

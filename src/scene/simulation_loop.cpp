@@ -151,8 +151,7 @@ void SimulationLoop::step(std::uint64_t k) {
   World& world = *scene_.world;
   if (session_) {
     session_->step(input_ ? input_->frame(k, double(k) * dt_) : HandFrame{});
-    contact_ = session_->grasp().active();
-    for (const FingerHaptics& f : session_->haptics().fingers) contact_ = contact_ || f.contacts > 0;
+    contact_ = session_->inContact();
     const HapticSample sample = sampleOf(double(k + 1) * dt_, session_->haptics(), scene_.session.hand.fingers);
     for (HapticOutput* out : settings_.outputs) out->send(sample);
   } else {

@@ -35,6 +35,9 @@ class HapticSession {
   const World& world() const { return world_; }
   const HandRig& rig() const { return rig_; }
   const Grasp& grasp() const { return grasp_; }
+  /// A finger touched a body in the last step, or a grasp holds one: the paper's "contact" state
+  /// (Table 3), as opposed to idle.
+  bool inContact() const;
   const HapticFrame& haptics() const { return haptics_.frame(); }
   /// The last step's stage times: the world's, plus Interact and Force.
   const StageTimes& times() const { return times_; }
