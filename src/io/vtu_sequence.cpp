@@ -17,7 +17,6 @@ std::string frameFile(const std::filesystem::path& pvdPath, std::size_t i) {
   return fmt::format("{}_{:05}.vtu", pvdPath.stem().string(), i);
 }
 
-
 }  // namespace
 
 VtuSequence::VtuSequence(std::filesystem::path pvdPath, TetMesh restMesh, TetWriteOptions options)
