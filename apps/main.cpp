@@ -18,7 +18,13 @@ int main(int argc, char** argv) {
   const auto runTouchCommand = vrd::addTouchCommand(app);
   const auto runBenchCommand = vrd::addBenchCommand(app);
 
-  CLI11_PARSE(app, argc, argv);
+  // Exit status: 0 fine; 1 a run failed part-way, a mesh has defects or a replay differs; 2 bad
+  // input, usage errors included (CLI11's own codes are folded into 2).
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
   try {
     if (app.got_subcommand("run") || app.got_subcommand("scenes")) return runRunCommand();
     if (app.got_subcommand("mesh")) return runMeshCommand();
