@@ -5,7 +5,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -42,10 +41,8 @@ void printScene(const BuiltScene& scene) {
     double mass = 0.0;
     for (float w : b.model->invMass)
       if (w > 0.0f) mass += 1.0 / w;
-    const Body& body = scene.world->body(b.id);
-    Vec3 lo = Vec3::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
-    for (Index i = body.firstParticle; i < body.firstParticle + body.particleCount; ++i)
-      lo = lo.cwiseMin(scene.world->particles().x[i].pos), hi = hi.cwiseMax(scene.world->particles().x[i].pos);
+    const Eigen::AlignedBox3f box = bodyBounds(*scene.world, b.id);
+    const Vec3 lo = box.min(), hi = box.max();
     fmt::print("body '{}': {} particles, {} tets, {} triangles, {:.3f} kg{}\n", b.name, b.model->particleCount(),
                b.model->tets.size(), b.model->triangles.size(), mass,
                b.embedding ? fmt::format(", render mesh of {} vertices", b.embedding->vertexCount()) : "");

@@ -45,6 +45,12 @@ Mat3 rotationOf(const std::array<float, 3>& degrees) {
 
 std::string fileName(const std::string& path) { return fs::path(path).filename().string(); }
 
+Eigen::AlignedBox3f boundsOf(const std::vector<Vec3>& points) {
+  Eigen::AlignedBox3f box;
+  for (const Vec3& p : points) box.extend(p);
+  return box;
+}
+
 }  // namespace
 
 PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log) {
@@ -88,8 +94,8 @@ PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log) {
   transform(out.tets.vertices, scaled);
   transform(out.surface.vertices, false);
   transform(out.render.vertices, false);
-  Vec3 lo = out.tets.vertices.front(), hi = lo;
-  for (const Vec3& v : out.tets.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  const Eigen::AlignedBox3f box = boundsOf(out.tets.vertices);
+  const Vec3 lo = box.min(), hi = box.max();
   if (!isFinite(lo) || !isFinite(hi)) throw Error(fmt::format("{}: coordinates overflow after scaling", body.mesh));
   const Vec3 shift = body.placement == Placement::Ground
                          ? Vec3(body.position.x() - 0.5f * (lo.x() + hi.x()), body.position.y() - lo.y(),
@@ -100,14 +106,19 @@ PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log) {
   return out;
 }
 
+Eigen::AlignedBox3f bodyBounds(const World& world, BodyId id) {
+  const Body& b = world.body(id);
+  Eigen::AlignedBox3f box;
+  for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) box.extend(world.particles().x[i].pos);
+  return box;
+}
+
 Vec3 topPoint(const World& world, BodyId id) {
   const Body& b = world.body(id);
   const auto& x = world.particles().x;
-  Vec3 low = Vec3::Constant(std::numeric_limits<float>::infinity()), high = -low;
-  for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i)
-    low = low.cwiseMin(x[i].pos), high = high.cwiseMax(x[i].pos);
-  const float nearTop = high.y() - 0.01f * (high.y() - low.y());
-  const Vec3 middle = 0.5f * (low + high);
+  const Eigen::AlignedBox3f box = bodyBounds(world, id);
+  const float nearTop = box.max().y() - 0.01f * box.sizes().y();
+  const Vec3 middle = box.center();
   float best = std::numeric_limits<float>::infinity();
   Vec3 top = Vec3::Constant(std::numeric_limits<float>::quiet_NaN());
   for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
@@ -165,13 +176,12 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log) {
     if (force != Vec3::Zero()) world.setExternalForce(body.id, force);
     if (!b.pin.empty()) {
       const auto& v = body.mesh.tets.vertices;
-      Vec3 lo = v.front(), hi = lo;
-      for (const Vec3& p : v) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+      const Eigen::AlignedBox3f box = boundsOf(v);
       std::size_t pinned = 0;
       for (Index i = 0; i < v.size(); ++i)
         for (const std::string& side : b.pin) {
           const int axis = side[1] - 'x';
-          const float bound = side[0] == '-' ? lo[axis] : hi[axis];
+          const float bound = side[0] == '-' ? box.min()[axis] : box.max()[axis];
           if (std::abs(v[i][axis] - bound) <= b.pinTolerance) {
             world.setInverseMass(world.particleIndex(body.id, i), 0.0f);
             ++pinned;

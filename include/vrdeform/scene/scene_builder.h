@@ -34,6 +34,9 @@ struct PlacedMesh {
 /// as the spec says, and the render mesh with it. Throws vrd::Error naming the file.
 PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log = {});
 
+/// The bounding box of a body's particles where they are now.
+Eigen::AlignedBox3f bodyBounds(const World& world, BodyId body);
+
 /// The top of a body: its highest particle; among those within 1% of the body's height of it (a
 /// flat top), the one nearest the vertical through the middle of its bounding box.
 Vec3 topPoint(const World& world, BodyId body);
