@@ -1,11 +1,11 @@
 #!/bin/sh
 # End to end with a (fake) glove: the fake middleware closes the hand over 1 s; `vrdeform ARGS...
-# --weart` (touch or run on the liver) must press it, send forces, and leave every thimble stopped
-# when it ends.
-# Usage: weart_e2e.sh VRDEFORM FAKE_WEART SCRATCH_DIR ARGS...
+# --weart` (touch or run on the liver) must press it, send a force to a thimble of FINGERS (a
+# regular expression such as INDEX), and leave every thimble stopped when it ends.
+# Usage: weart_e2e.sh VRDEFORM FAKE_WEART SCRATCH_DIR FINGERS ARGS...
 set -eu
-vrdeform=$1 fake=$2 dir=$3
-shift 3
+vrdeform=$1 fake=$2 dir=$3 fingers=$4
+shift 4
 mkdir -p "$dir"
 printf '# t thumb index middle\n0 0 0 0\n1 0.9 0.9 0.9\n' > "$dir/close.script"
 "$fake" --port 0 --seconds 20 --script "$dir/close.script" --log "$dir/fake.log" > "$dir/fake.out" 2>&1 &
@@ -18,7 +18,7 @@ port=$(sed -n 's/^listening on 127\.0\.0\.1:\([0-9]*\).*/\1/p' "$dir/fake.out")
 kill -TERM $pid && wait $pid || true  # the fake flushes its log as it exits
 trap - EXIT
 echo "--- fake middleware log:"; cat "$dir/fake.log"
-grep -Eq 'force RIGHT (THUMB|INDEX|MIDDLE) 0\.[0-9]*[1-9]' "$dir/fake.log" || { echo "FAIL: no force reached the glove"; exit 1; }
+grep -Eq "force RIGHT ($fingers) 0\.[0-9]*[1-9]" "$dir/fake.log" || { echo "FAIL: no $fingers force reached the glove"; exit 1; }
 grep -q 'StopFromClient' "$dir/fake.log" || { echo "FAIL: no StopFromClient"; exit 1; }
 for point in THUMB INDEX MIDDLE; do
   last=$(grep -E "(force|stopForce) RIGHT $point" "$dir/fake.log" | tail -1)
