@@ -180,7 +180,7 @@ json scaling(const BenchArgs& a, std::string& text) {
     std::size_t n = 0;
     for (bool simd : {true, false}) {
       SolverSettings s;
-      s.simd = simd;
+      s.simd = simd ? SimdLevel::Best : SimdLevel::Off;
       World world(s);
       Material m;
       m.elastic = ElasticModuli{2e4f, 0.45f, 1000.0f, 0.002f};

@@ -30,7 +30,7 @@ TetMesh block(int tets) { return makeBoxTetsNear(Vec3::Zero(), Vec3(0.1f, 0.1f, 
 void runSteps(benchmark::State& state, const TetMesh& mesh, const ConstraintSet& set, int iterations, bool simd) {
   SolverSettings settings;
   settings.iterations = iterations;
-  settings.simd = simd;
+  settings.simd = simd ? SimdLevel::Best : SimdLevel::Off;
   settings.timeStages = false;
   World world(settings);
   const auto model = makeSoftBody(mesh, benchMaterial(), set);

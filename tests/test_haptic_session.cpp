@@ -267,8 +267,10 @@ TEST(HapticSession, LiverPokeForceRisesWithDepthAndReturnsToZero) {
   EXPECT_GE(rhoFinger, 0.99);
   EXPECT_GE(rhoNewtons, 0.99);
   // Algorithm 2's own value averages the multipliers over N(r) (eq. 40), so it dips whenever one
-  // more contact joins the set; it still follows the depth, less strictly.
-  EXPECT_GE(rhoPaper, 0.95);
+  // more contact joins the set; it still follows the depth, less strictly. How much it dips
+  // depends on the Gauss-Seidel order at these 5 iterations: 0.983 in the mesh's order, 0.949 in
+  // the coloured order (constraint_colouring.h).
+  EXPECT_GE(rhoPaper, 0.93);
   EXPECT_GT(finger.back(), 0.5);
 
   // One second after release, every output is back at 0 (the smoothing's tail: 0.8^60 < 1e-5).

@@ -45,6 +45,7 @@ iterations = 8
 gravity = [0, -9.8, 0.5]
 linear_damping = 0.2
 simd = false
+threads = 2
 
 [[body]]
 name = "liver"
@@ -201,7 +202,8 @@ TEST(SceneFile, FullSceneSetsEveryField) {
   EXPECT_EQ(s.solver.iterations, 8);
   EXPECT_EQ(s.solver.gravity, Vec3(0, -9.8f, 0.5f));
   EXPECT_FLOAT_EQ(s.solver.linearDamping, 0.2f);
-  EXPECT_FALSE(s.solver.simd);
+  EXPECT_EQ(s.solver.simd, SimdLevel::Off);
+  EXPECT_EQ(s.solver.threads, 2);
 
   ASSERT_EQ(s.bodies.size(), 3u);
   const BodySpec& liver = s.bodies[0];
@@ -350,7 +352,8 @@ TEST(SceneFile, AbsentKeysKeepTheirDefaults) {
   EXPECT_EQ(s.solver.substeps, d.solver.substeps);
   EXPECT_EQ(s.solver.iterations, d.solver.iterations);
   EXPECT_EQ(s.solver.gravity, d.solver.gravity);
-  EXPECT_TRUE(s.solver.simd);
+  EXPECT_EQ(s.solver.simd, SimdLevel::Best);
+  EXPECT_EQ(s.solver.threads, 1);
 
   ASSERT_EQ(s.bodies.size(), 1u);
   const BodySpec& b = s.bodies[0];

@@ -385,7 +385,7 @@ void validateAt(const Table& t, std::string_view prefix, F&& validate) {
 }
 
 SolverSettings readSolver(const Table& t) {
-  t.allowOnly({"rate", "dt", "substeps", "iterations", "gravity", "linear_damping", "simd"});
+  t.allowOnly({"rate", "dt", "substeps", "iterations", "gravity", "linear_damping", "simd", "threads"});
   t.exclusive("rate", "dt");
   SolverSettings s;
   if (std::optional<Field> f = t.get("rate")) s.timeStep = 1.0f / float(f->integer(1, 100000));
@@ -394,7 +394,10 @@ SolverSettings readSolver(const Table& t) {
   t.readInt("iterations", s.iterations, 1, 1000);
   t.readVec3("gravity", s.gravity);
   t.readNumber("linear_damping", s.linearDamping, kNonNegative);
-  t.readBool("simd", s.simd);
+  bool simd = true;
+  t.readBool("simd", simd);
+  s.simd = simd ? SimdLevel::Best : SimdLevel::Off;
+  t.readInt("threads", s.threads, 1, 256);
   validateAt(t, "solver", [&] { validateSolverSettings(s); });
   return s;
 }

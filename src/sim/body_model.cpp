@@ -9,7 +9,7 @@
 
 #include "vrdeform/error.h"
 #include "vrdeform/mesh/boundary.h"
-#include "vrdeform/sim/lane_batches.h"
+#include "vrdeform/sim/constraint_colouring.h"
 
 namespace vrd {
 namespace {
@@ -90,18 +90,22 @@ std::vector<T> permuted(const std::vector<T>& items, const std::vector<Index>& o
   return out;
 }
 
-// Puts the distance constraints in lane order.
-void batchDistances(BodyModel& model) {
-  const LaneOrder order = orderForLanes(particlesOf(model.distance));
-  model.distance = permuted(model.distance, order.order);
-  model.batchedDistance = order.batched;
+// Colours with fewer constraints than this are left to the serial remainder: a colour costs the
+// threads a barrier, and one this small would not fill their SIMD lanes.
+constexpr std::size_t kMinColourSize = 32;
+
+// Puts the distance constraints in colour order.
+void colourDistances(BodyModel& model, SolveOrder order) {
+  if (order != SolveOrder::Coloured) return;
+  const Colouring c = colourConstraints(particlesOf(model.distance), kMinColourSize);
+  model.distance = permuted(model.distance, c.order);
+  model.distanceColours = c.colourStart;
 }
 
 template <typename C>
-void checkBatches(const char* what, const std::vector<C>& constraints, std::size_t batched) {
-  if (!lanesIndependent(particlesOf(constraints), batched))
-    throw Error(fmt::format("{} constraints: the first {} are not in groups of {} that share no particle", what,
-                            batched, kLanes));
+void checkColours(const char* what, const std::vector<C>& constraints, const std::vector<std::uint32_t>& colours) {
+  if (!constraints.empty() && !coloursIndependent(particlesOf(constraints), colours))
+    throw Error(fmt::format("{} constraints: a colour holds two constraints that share a particle", what));
 }
 
 }  // namespace
@@ -136,13 +140,18 @@ ShapeMatchModel makeShapeMatchModel(const BodyModel& model, float compliance) {
 }
 
 std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Material& material,
-                                              const ConstraintSet& constraints) {
+                                              const ConstraintSet& constraints, SolveOrder order) {
   validateTetMesh(mesh);
   validateMaterial(material);
   auto model = std::make_shared<BodyModel>();
   model->restPositions = mesh.vertices;
-  const LaneOrder tetOrder = orderForLanes(mesh.tets);
-  model->tets = permuted(mesh.tets, tetOrder.order);
+  if (order == SolveOrder::Coloured) {
+    const Colouring c = colourConstraints(mesh.tets, kMinColourSize);
+    model->tets = permuted(mesh.tets, c.order);
+    model->tetColours = c.colourStart;
+  } else {
+    model->tets = mesh.tets;
+  }
   model->surface = boundaryFaces(mesh);  // indexes mesh.vertices = restPositions; by the mesh's tet order
   model->damping = dampingOf(material);
   model->particleRadius = material.particleRadius;
@@ -211,13 +220,11 @@ std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Materia
     }
   }
   if (constraints.shapeMatching) model->shapeMatching = makeShapeMatchModel(*model, material.shapeMatching.compliance);
-  batchDistances(*model);
-  model->batchedVolume = model->volume.empty() ? 0 : tetOrder.batched;
-  model->batchedStrain = model->strain.empty() ? 0 : tetOrder.batched;
+  colourDistances(*model, order);
   return model;
 }
 
-std::shared_ptr<const BodyModel> makeCloth(const TriMesh& mesh, const Material& material) {
+std::shared_ptr<const BodyModel> makeCloth(const TriMesh& mesh, const Material& material, SolveOrder order) {
   validateTriMesh(mesh);
   validateMaterial(material);
   if (material.elastic) throw Error("material: cloth takes compliances, not elastic moduli");
@@ -245,7 +252,7 @@ std::shared_ptr<const BodyModel> makeCloth(const TriMesh& mesh, const Material& 
       model->bend.push_back(b);
     }
   }
-  batchDistances(*model);
+  colourDistances(*model, order);
   std::vector<char> used(mesh.vertices.size(), 0);
   for (const Triangle& t : mesh.triangles)
     for (Index v : t) used[v] = 1;
@@ -305,9 +312,9 @@ void validateModel(const BodyModel& model) {
     if (!finiteNonNegative(sm->compliance)) throw Error("shape matching compliance must be finite and >= 0");
     if (!(sm->totalMass > 0.0f)) throw Error("shape matching needs a positive total mass");
   }
-  checkBatches("distance", model.distance, model.batchedDistance);
-  checkBatches("volume", model.volume, model.batchedVolume);
-  checkBatches("strain", model.strain, model.batchedStrain);
+  checkColours("distance", model.distance, model.distanceColours);
+  checkColours("volume", model.volume, model.tetColours);
+  checkColours("strain", model.strain, model.tetColours);
   const ConstraintDamping& d = model.damping;
   for (float beta : {d.distance, d.volume, d.strainStretch, d.strainShear, d.bend, d.shapeMatching})
     if (!finiteNonNegative(beta)) throw Error(fmt::format("damping must be finite and >= 0, got {}", beta));

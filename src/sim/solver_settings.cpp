@@ -2,9 +2,34 @@
 
 #include <fmt/format.h>
 
+#include <iterator>
+
 #include "vrdeform/error.h"
 
 namespace vrd {
+
+bool cpuSupports(SimdLevel level) {
+  switch (level) {
+    case SimdLevel::Avx2:
+      return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    case SimdLevel::Avx512:
+      return __builtin_cpu_supports("avx512f");
+    default:
+      return true;
+  }
+}
+
+SimdLevel resolveSimd(SimdLevel level) {
+  if (level != SimdLevel::Best) return level;
+  return cpuSupports(SimdLevel::Avx512) ? SimdLevel::Avx512
+         : cpuSupports(SimdLevel::Avx2) ? SimdLevel::Avx2
+                                        : SimdLevel::Sse;
+}
+
+const char* simdName(SimdLevel level) {
+  constexpr const char* kNames[] = {"off", "sse", "avx2", "avx512", "best"};
+  return std::size_t(level) < std::size(kNames) ? kNames[std::size_t(level)] : "unknown";
+}
 
 void validateSolverSettings(const SolverSettings& s) {
   if (!(std::isfinite(s.timeStep) && s.timeStep > 0.0f))
@@ -14,6 +39,10 @@ void validateSolverSettings(const SolverSettings& s) {
   if (!isFinite(s.gravity)) throw Error("solver: gravity must be finite");
   if (!(std::isfinite(s.linearDamping) && s.linearDamping >= 0.0f))
     throw Error(fmt::format("solver: linear damping must be finite and >= 0, got {}", s.linearDamping));
+  if (s.threads < 1 || s.threads > 256)
+    throw Error(fmt::format("solver: threads must be in [1, 256], got {}", s.threads));
+  if (std::size_t(s.simd) > std::size_t(SimdLevel::Best)) throw Error("solver: unknown SIMD level");
+  if (!cpuSupports(s.simd)) throw Error(fmt::format("solver: this CPU cannot run SIMD level {}", simdName(s.simd)));
 }
 
 }  // namespace vrd

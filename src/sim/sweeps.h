@@ -1,23 +1,20 @@
 #pragma once
-// One Gauss-Seidel sweep per constraint type over a body. Distance, volume and strain are written
-// once for lane width 1 (float, Eigen vectors) and 4 (Lane4, V3<Lane4>): with T = Lane4 a sweep
-// takes four consecutive, independent constraints at a time (lane_batches.h), which is the same
-// sweep as taking them one by one. Bending and shape matching run one at a time.
+// One Gauss-Seidel sweep per constraint type over a range of a body's constraints. Distance,
+// volume and strain are written once for every width: T = float (one constraint, Eigen vectors)
+// or a lane type (lanes.h: kWidth<T> consecutive constraints of one colour at once, which is the
+// same sweep as taking them one by one). Bending and shape matching run one at a time.
 
-#include <cstring>
 #include <type_traits>
 
+#include "lane_io.h"
 #include "vrdeform/sim/body.h"
-#include "vrdeform/sim/lane_batches.h"
 
 namespace vrd::sweeps {
 
 template <typename T>
-inline constexpr std::size_t kWidth = std::is_same_v<T, Lane4> ? kLanes : 1;
-template <typename T>
-using VecOf = std::conditional_t<std::is_same_v<T, Lane4>, V3<Lane4>, Vec3>;
+using VecOf = std::conditional_t<std::is_same_v<T, float>, Vec3, V3<T>>;
 
-/// The N particles of one constraint (T = float) or of kLanes constraints (T = Lane4), with their
+/// The N particles of one constraint (T = float) or of kWidth<T> constraints (lanes), with their
 /// inverse masses and, when damped, their motion since the start of the substep.
 template <typename T, std::size_t N, bool Damped>
 struct Gathered {
@@ -46,51 +43,21 @@ struct Gathered {
   }
 
  private:
-  static void load(const Point* pts, const Index (&i)[1], Vec3& x, float& w) {
-    x = pts[i[0]].pos;
-    w = pts[i[0]].w;
-  }
-  static void add(Point* pts, const Index (&i)[1], const Vec3& d) { pts[i[0]].pos += d; }
-
-  // A Point is 16 aligned bytes (x, y, z, w): four loads and a transpose give the lanes.
-  static void load(const Point* pts, const Index (&i)[kLanes], V3<Lane4>& x, Lane4& w) {
-    __m128 r0 = _mm_load_ps(pts[i[0]].pos.data()), r1 = _mm_load_ps(pts[i[1]].pos.data());
-    __m128 r2 = _mm_load_ps(pts[i[2]].pos.data()), r3 = _mm_load_ps(pts[i[3]].pos.data());
-    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-    x = {r0, r1, r2};
-    w = r3;
-  }
-  static void add(Point* pts, const Index (&i)[kLanes], const V3<Lane4>& d) {
-    __m128 r0 = d.x, r1 = d.y, r2 = d.z, r3 = _mm_setzero_ps();  // w += 0
-    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-    const __m128 rows[kLanes] = {r0, r1, r2, r3};
-    for (std::size_t l = 0; l < kLanes; ++l) {
-      float* p = pts[i[l]].pos.data();
-      _mm_store_ps(p, _mm_add_ps(_mm_load_ps(p), rows[l]));
+  static void load(const Point* pts, const Index* i, V& x, T& w) {
+    if constexpr (kWidth<T> == 1) {
+      x = pts[i[0]].pos;
+      w = pts[i[0]].w;
+    } else {
+      loadPoints(pts, i, x, w);
     }
   }
+  static void add(Point* pts, const Index* i, const V& d) {
+    if constexpr (kWidth<T> == 1)
+      pts[i[0]].pos += d;
+    else
+      addPoints(pts, i, d);
+  }
 };
-
-/// A per-constraint float field as a scalar or as lanes.
-template <typename T, typename C>
-T fieldOf(const C* c, float C::*field) {
-  if constexpr (std::is_same_v<T, Lane4>)
-    return Lane4{c[0].*field, c[1].*field, c[2].*field, c[3].*field};
-  else
-    return c[0].*field;
-}
-
-template <typename T>
-T loadLambda(const float* lambda) {
-  T v;
-  std::memcpy(&v, lambda, sizeof(T));
-  return v;
-}
-template <typename T>
-void addLambda(float* lambda, T delta) {
-  const T v = loadLambda<T>(lambda) + delta;
-  std::memcpy(lambda, &v, sizeof(T));
-}
 
 // Everything a sweep needs about the body it runs over.
 struct Range {
@@ -107,8 +74,8 @@ void distance(const DistanceConstraint* c, std::size_t begin, std::size_t end, f
     const auto k =
         XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &DistanceConstraint::compliance), splat<T>(tau), r.invH);
     const auto out = solveDistance(g.x, g.w, fieldOf<T>(c + i, &DistanceConstraint::restLength),
-                                   loadLambda<T>(lambda + i), k, g.displacement());
-    addLambda(lambda + i, out.dLambda);
+                                   loadLanes<T>(lambda + i), k, g.displacement());
+    addLanes<T>(lambda + i, out.dLambda);
     g.scatter(out.dp, r.pred);
   }
 }
@@ -118,73 +85,87 @@ void volume(const VolumeConstraint* c, std::size_t begin, std::size_t end, float
   for (std::size_t i = begin; i < end; i += kWidth<T>) {
     const Gathered<T, 4, Damped> g(c + i, r.pred, r.start);
     const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &VolumeConstraint::compliance), splat<T>(tau), r.invH);
-    const auto out = solveVolume(g.x, g.w, fieldOf<T>(c + i, &VolumeConstraint::restVolume), loadLambda<T>(lambda + i),
+    const auto out = solveVolume(g.x, g.w, fieldOf<T>(c + i, &VolumeConstraint::restVolume), loadLanes<T>(lambda + i),
                                  k, g.displacement());
-    addLambda(lambda + i, out.dLambda);
+    addLanes<T>(lambda + i, out.dLambda);
     g.scatter(out.dp, r.pred);
   }
 }
 
-// Strain weights a_k (strainWeights) of one tet or of kLanes tets. For lanes: column i of each
-// tet's D_rest^-1 is contiguous (Eigen is column-major) and holds (a_1[i], a_2[i], a_3[i]), so one
-// load per tet and a transpose give a_1[i], a_2[i] and a_3[i] for all four. The fourth float read
-// belongs to the next column or to the constraint's compliance and is discarded.
+// Strain weights a_k (strainWeights) of one tet or of kWidth<T> tets. For lanes, per group of
+// four: column i of each tet's D_rest^-1 is contiguous (Eigen is column-major) and holds
+// (a_1[i], a_2[i], a_3[i]), so one load per tet and a transpose give a_1[i], a_2[i] and a_3[i] for
+// all four. The fourth float read belongs to the next column or to the constraint's compliance
+// and is discarded.
 template <typename T>
 void strainWeightsOf(const StrainConstraint* c, VecOf<T> (&a)[4]) {
-  if constexpr (std::is_same_v<T, Lane4>) {
-    Lane4 column[3][3];  // column[i][k] = a_{k+1}[i]
-    for (int i = 0; i < 3; ++i) {
-      __m128 r0 = _mm_loadu_ps(c[0].invRestShape.data() + 3 * i), r1 = _mm_loadu_ps(c[1].invRestShape.data() + 3 * i);
-      __m128 r2 = _mm_loadu_ps(c[2].invRestShape.data() + 3 * i), r3 = _mm_loadu_ps(c[3].invRestShape.data() + 3 * i);
-      _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-      column[i][0] = r0, column[i][1] = r1, column[i][2] = r2;
-    }
-    for (int k = 0; k < 3; ++k) a[k + 1] = {column[0][k], column[1][k], column[2][k]};
-    a[0] = -(a[1] + a[2] + a[3]);
-  } else {
+  if constexpr (kWidth<T> == 1) {
     const auto w = strainWeights(c[0].invRestShape);
     for (int k = 0; k < 4; ++k) a[k] = w[k];
+  } else {
+    Lane4 column[3][3][kGroups<T>];  // column[i][k][g] = a_{k+1}[i] of group g
+    for (std::size_t g = 0; g < kGroups<T>; ++g) {
+      // The matrices' floats, without calling Eigen here (lane_sweeps.h: no shared inline code).
+      const auto* m = reinterpret_cast<const float(*)[9]>(&c[4 * g].invRestShape);
+      const std::size_t stride = sizeof(StrainConstraint) / sizeof(float);
+      static_assert(sizeof(StrainConstraint) % sizeof(float) == 0 && sizeof(Mat3) == 9 * sizeof(float));
+      for (int i = 0; i < 3; ++i) {
+        const float* col = *m + 3 * i;
+        __m128 r0 = _mm_loadu_ps(col), r1 = _mm_loadu_ps(col + stride);
+        __m128 r2 = _mm_loadu_ps(col + 2 * stride), r3 = _mm_loadu_ps(col + 3 * stride);
+        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+        column[i][0][g] = r0, column[i][1][g] = r1, column[i][2][g] = r2;
+      }
+    }
+    for (int k = 0; k < 3; ++k) a[k + 1] = {concat<T>(column[0][k]), concat<T>(column[1][k]), concat<T>(column[2][k])};
+    a[0] = -(a[1] + a[2] + a[3]);
   }
 }
 
-// The six strain multipliers of one tet, or of kLanes consecutive tets as lanes: the tets' 24
-// floats are contiguous, so components 0-3 and 2-5 of each tet load as one vector each and two
-// transposes give all six lanes.
+// The six strain multipliers of one tet, or of kWidth<T> consecutive tets as lanes: per group of
+// four, the tets' 24 floats are contiguous, so components 0-3 and 2-5 of each tet load as one
+// vector each and two transposes give all six lanes.
 template <typename T>
 StrainLambdaT<T> loadStrainLambda(const StrainLambda* lambda) {
-  if constexpr (std::is_same_v<T, Lane4>) {
-    static_assert(sizeof(StrainLambda) == 6 * sizeof(float));
-    const float* f = lambda->data();
-    __m128 a0 = _mm_loadu_ps(f), a1 = _mm_loadu_ps(f + 6), a2 = _mm_loadu_ps(f + 12), a3 = _mm_loadu_ps(f + 18);
-    __m128 b0 = _mm_loadu_ps(f + 2), b1 = _mm_loadu_ps(f + 8), b2 = _mm_loadu_ps(f + 14), b3 = _mm_loadu_ps(f + 20);
-    _MM_TRANSPOSE4_PS(a0, a1, a2, a3);
-    _MM_TRANSPOSE4_PS(b0, b1, b2, b3);
-    return {a0, a1, a2, a3, b2, b3};
-  } else {
+  static_assert(sizeof(StrainLambda) == 6 * sizeof(float));
+  if constexpr (kWidth<T> == 1) {
     return *lambda;
+  } else {
+    Lane4 part[kStrainComponents][kGroups<T>];
+    for (std::size_t g = 0; g < kGroups<T>; ++g) {
+      const float* f = reinterpret_cast<const float*>(lambda + 4 * g);
+      __m128 a0 = _mm_loadu_ps(f), a1 = _mm_loadu_ps(f + 6), a2 = _mm_loadu_ps(f + 12), a3 = _mm_loadu_ps(f + 18);
+      __m128 b0 = _mm_loadu_ps(f + 2), b1 = _mm_loadu_ps(f + 8), b2 = _mm_loadu_ps(f + 14), b3 = _mm_loadu_ps(f + 20);
+      _MM_TRANSPOSE4_PS(a0, a1, a2, a3);
+      _MM_TRANSPOSE4_PS(b0, b1, b2, b3);
+      part[0][g] = a0, part[1][g] = a1, part[2][g] = a2, part[3][g] = a3, part[4][g] = b2, part[5][g] = b3;
+    }
+    StrainLambdaT<T> out;
+    for (int c = 0; c < kStrainComponents; ++c) out[c] = concat<T>(part[c]);
+    return out;
   }
 }
 
 template <typename T>
 void addStrainLambda(StrainLambda* lambda, const StrainLambdaT<T>& delta) {
-  if constexpr (std::is_same_v<T, Lane4>) {
-    const StrainLambdaT<Lane4> sum = [&] {
-      StrainLambdaT<Lane4> s = loadStrainLambda<Lane4>(lambda);
-      for (int c = 0; c < kStrainComponents; ++c) s[c] += delta[c];
-      return s;
-    }();
-    __m128 a0 = sum[0], a1 = sum[1], a2 = sum[2], a3 = sum[3], b0 = sum[4], b1 = sum[5], b2 = _mm_setzero_ps(),
-           b3 = _mm_setzero_ps();
-    _MM_TRANSPOSE4_PS(a0, a1, a2, a3);  // a_l = components 0-3 of tet l
-    _MM_TRANSPOSE4_PS(b0, b1, b2, b3);  // b_l = components 4, 5 of tet l (and two zeros)
-    const __m128 low[kLanes] = {a0, a1, a2, a3}, high[kLanes] = {b0, b1, b2, b3};
-    for (std::size_t l = 0; l < kLanes; ++l) {
-      float* f = lambda[l].data();
-      _mm_storeu_ps(f, low[l]);
-      _mm_storel_pi(reinterpret_cast<__m64*>(f + 4), high[l]);
-    }
-  } else {
+  if constexpr (kWidth<T> == 1) {
     for (int c = 0; c < kStrainComponents; ++c) (*lambda)[c] += delta[c];
+  } else {
+    StrainLambdaT<T> sum = loadStrainLambda<T>(lambda);
+    Lane4 part[kStrainComponents][kGroups<T>];
+    for (int c = 0; c < kStrainComponents; ++c) split(T(sum[c] + delta[c]), part[c]);
+    for (std::size_t g = 0; g < kGroups<T>; ++g) {
+      __m128 a0 = part[0][g], a1 = part[1][g], a2 = part[2][g], a3 = part[3][g], b0 = part[4][g], b1 = part[5][g],
+             b2 = _mm_setzero_ps(), b3 = _mm_setzero_ps();
+      _MM_TRANSPOSE4_PS(a0, a1, a2, a3);  // a_l = components 0-3 of tet l
+      _MM_TRANSPOSE4_PS(b0, b1, b2, b3);  // b_l = components 4, 5 of tet l (and two zeros)
+      const __m128 low[4] = {a0, a1, a2, a3}, high[4] = {b0, b1, b2, b3};
+      for (std::size_t l = 0; l < 4; ++l) {
+        float* f = reinterpret_cast<float*>(lambda + 4 * g + l);
+        _mm_storeu_ps(f, low[l]);
+        _mm_storel_pi(reinterpret_cast<__m64*>(f + 4), high[l]);
+      }
+    }
   }
 }
 
@@ -231,20 +212,6 @@ inline void shapeMatching(const ShapeMatchModel& sm, Vec3* lambda, Eigen::Quater
     const Vec3 dLambda = solveShapeMatchParticle(pred[i], goal, lambda[i], k, disp);
     lambda[i] += dLambda;
     pred[i].pos += pred[i].w * dLambda;
-  }
-}
-
-/// Calls run(damped, width, begin, end) for the lanes over the batched prefix (when simd is on) and
-/// then one at a time over the rest; damped and width are compile-time tags.
-template <typename Run>
-void widths(bool simd, std::size_t batched, std::size_t count, bool damped, Run run) {
-  const std::size_t split = simd ? batched : 0;
-  if (damped) {
-    run(std::integral_constant<bool, true>{}, Lane4{}, 0, split);
-    run(std::integral_constant<bool, true>{}, 0.0f, split, count);
-  } else {
-    run(std::integral_constant<bool, false>{}, Lane4{}, 0, split);
-    run(std::integral_constant<bool, false>{}, 0.0f, split, count);
   }
 }
 

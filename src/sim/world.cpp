@@ -8,7 +8,8 @@
 #include <type_traits>
 #include <utility>
 
-#include "sweeps.h"
+#include "lane_sweeps.h"
+#include "solver_team.h"
 #include "vrdeform/error.h"
 
 namespace vrd {
@@ -212,7 +213,7 @@ void World::step() {
     predict(h);
     detectContacts();
     resetMultipliers();
-    for (int it = 0; it < settings_.iterations; ++it) solveIteration(h);
+    solveIterations(h);
     finalise(h);
   }
   const auto pushed = [](float l) { return l > 0.0f; };
@@ -311,9 +312,42 @@ void World::resetMultipliers() {
   fingertipTriangleImpulse_.assign(fingertipTriangleContacts_.size(), {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
 }
 
-void World::solveIteration(float h) {
+void World::solveIterations(float h) {
+  const sweeps::LanePlan plan = sweeps::lanePlan(settings_.simd);
+  if (settings_.threads > 1) {
+#pragma omp parallel num_threads(settings_.threads)
+    {
+      const SolverTeam team = SolverTeam::current();
+      for (int it = 0; it < settings_.iterations; ++it) solveIteration(h, plan, team);
+    }
+  } else {
+    for (int it = 0; it < settings_.iterations; ++it) solveIteration(h, plan, SolverTeam{});
+  }
+}
+
+namespace {
+
+// One constraint array in colour order: each colour shared by the team and run through the lane
+// widths, widest first, then the remainder one at a time by the leader. `project(sweeps, begin,
+// end)` calls the array's sweep of that width and returns where it stopped.
+template <typename Project>
+void sweepColours(const std::vector<std::uint32_t>& colours, std::size_t count, const sweeps::LanePlan& plan,
+                  const SolverTeam& team, Project project) {
+  constexpr std::size_t kAlign = 16;  // the widest lanes: every share but the last holds whole batches
+  for (std::size_t k = 0; k + 1 < colours.size(); ++k) {
+    auto [begin, end] = team.share(colours[k], colours[k + 1], kAlign);
+    for (std::size_t w = 0; w < plan.count; ++w) begin = project(*plan.widths[w], begin, end);
+    team.barrier();
+  }
+  if (team.leader()) project(sweeps::scalarSweeps(), colours.empty() ? 0 : colours.back(), count);
+  team.barrier();
+}
+
+}  // namespace
+
+void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team) {
   const float invH = 1.0f / h;
-  const bool timed = settings_.timeStages;
+  const bool timed = settings_.timeStages && team.leader();
   StageTimes& times = report_.times;
   Point* const pred = particles_.p.data();
   const Point* const start = particles_.x.data();
@@ -323,33 +357,33 @@ void World::solveIteration(float h) {
     const BodyModel& m = *b.model;
     const ConstraintDamping& tau = m.damping;
     const sweeps::Range r{pred + b.firstParticle, start + b.firstParticle, invH};
-    const bool simd = settings_.simd;
     if (!m.distance.empty()) {
       StageTimer t(times, Stage::Distance, timed);
-      sweeps::widths(simd, m.batchedDistance, m.distance.size(), tau.distance > 0.0f,
-                     [&](auto damped, auto width, std::size_t begin, std::size_t end) {
-                       sweeps::distance<decltype(width), damped>(m.distance.data(), begin, end, b.distanceLambda.data(),
-                                                                 tau.distance, r);
-                     });
+      const bool damped = tau.distance > 0.0f;
+      sweepColours(m.distanceColours, m.distance.size(), plan, team,
+                   [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
+                     return s.distance(m.distance.data(), begin, end, b.distanceLambda.data(), tau.distance, damped, r);
+                   });
     }
     // Strain before volume: S = F^T F cannot tell a tet from its mirror image, so the signed
     // volume constraint gets the last word on orientation.
     if (!m.strain.empty()) {
       StageTimer t(times, Stage::Strain, timed);
-      sweeps::widths(simd, m.batchedStrain, m.strain.size(), tau.strainStretch > 0.0f || tau.strainShear > 0.0f,
-                     [&](auto damped, auto width, std::size_t begin, std::size_t end) {
-                       sweeps::strain<decltype(width), damped>(m.strain.data(), begin, end, b.strainLambda.data(), tau,
-                                                               r);
-                     });
+      const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f;
+      sweepColours(m.tetColours, m.strain.size(), plan, team,
+                   [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
+                     return s.strain(m.strain.data(), begin, end, b.strainLambda.data(), tau, damped, r);
+                   });
     }
     if (!m.volume.empty()) {
       StageTimer t(times, Stage::Volume, timed);
-      sweeps::widths(simd, m.batchedVolume, m.volume.size(), tau.volume > 0.0f,
-                     [&](auto damped, auto width, std::size_t begin, std::size_t end) {
-                       sweeps::volume<decltype(width), damped>(m.volume.data(), begin, end, b.volumeLambda.data(),
-                                                               tau.volume, r);
-                     });
+      const bool damped = tau.volume > 0.0f;
+      sweepColours(m.tetColours, m.volume.size(), plan, team,
+                   [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
+                     return s.volume(m.volume.data(), begin, end, b.volumeLambda.data(), tau.volume, damped, r);
+                   });
     }
+    if (!team.leader()) continue;  // the rest of the body runs one at a time
     if (!m.bend.empty()) {
       StageTimer t(times, Stage::Bend, timed);
       if (tau.bend > 0.0f)
@@ -362,8 +396,16 @@ void World::solveIteration(float h) {
       sweeps::shapeMatching(*m.shapeMatching, b.shapeMatchLambda.data(), b.shapeMatchRotation, tau.shapeMatching, r);
     }
   }
+  // The world-level constraints, by the leader; the others wait for it at the end.
+  if (team.leader()) solveWorldConstraints(invH, timed);
+  team.barrier();
+}
 
-  // World-level constraints come last in the sweep so that they have the last word (P3).
+// After the bodies' own constraints, so that they have the last word (P3).
+void World::solveWorldConstraints(float invH, bool timed) {
+  StageTimes& times = report_.times;
+  Point* const pred = particles_.p.data();
+  const Point* const start = particles_.x.data();
   if (!attachments_.empty()) {
     StageTimer t(times, Stage::Attachment, timed);
     for (std::size_t a = 0; a < attachments_.size(); ++a) {

@@ -1,17 +1,29 @@
 #pragma once
-// One maths, three widths: a 3-vector over a scalar type T that is float (the scalar solver),
-// double (derivative checks) or Lane4, four floats in an SSE register (four constraints at once).
-// Constraint kernels written over V3<T> run unchanged at every width, so the scalar and SIMD
-// paths cannot drift apart. The member names follow Eigen's so that the same kernels also accept
-// Eigen vectors.
+// One maths, every width: a 3-vector over a scalar type T that is float (the scalar solver),
+// double (derivative checks) or a lane type: Lane4 (SSE, every x86-64), Lane8 (AVX2) or Lane16
+// (AVX-512), that many constraints at once. Constraint kernels written over V3<T> run unchanged at
+// every width, so the scalar and SIMD paths cannot drift apart. The member names follow Eigen's so
+// that the same kernels also accept Eigen vectors. Lane8 and Lane16 exist only in translation
+// units compiled for their instruction set (src/sim/sweeps_avx*.cpp), chosen at run time.
 
-#include <xmmintrin.h>
+#include <immintrin.h>
 #include <cmath>
+#include <cstddef>
 
 namespace vrd {
 
 /// Four floats processed together (GCC/Clang vector extension; SSE on any x86-64).
 using Lane4 = float __attribute__((vector_size(16)));
+#ifdef __AVX2__
+using Lane8 = float __attribute__((vector_size(32)));  ///< eight floats (AVX2)
+#endif
+#ifdef __AVX512F__
+using Lane16 = float __attribute__((vector_size(64)));  ///< sixteen floats (AVX-512)
+#endif
+
+/// Lanes of T: 1 for float, 4 for Lane4, ...
+template <typename T>
+inline constexpr std::size_t kWidth = sizeof(T) / sizeof(float);
 
 template <typename T>
 T splat(double v) {
@@ -19,9 +31,20 @@ T splat(double v) {
 }
 template <>
 inline Lane4 splat<Lane4>(double v) {
-  const float f = float(v);
-  return Lane4{f, f, f, f};
+  return Lane4{} + float(v);
 }
+#ifdef __AVX2__
+template <>
+inline Lane8 splat<Lane8>(double v) {
+  return Lane8{} + float(v);
+}
+#endif
+#ifdef __AVX512F__
+template <>
+inline Lane16 splat<Lane16>(double v) {
+  return Lane16{} + float(v);
+}
+#endif
 
 /// Per-lane choice: `mask ? a : b` (mask is a bool for scalars and a lane mask for Lane4).
 template <typename M, typename T>
@@ -32,6 +55,14 @@ T select(M mask, T a, T b) {
 inline float sqrt(float v) { return std::sqrt(v); }
 inline double sqrt(double v) { return std::sqrt(v); }
 inline Lane4 sqrt(Lane4 v) { return _mm_sqrt_ps(v); }
+#ifdef __AVX2__
+inline Lane8 sqrt(Lane8 v) { return _mm256_sqrt_ps(v); }
+#endif
+#ifdef __AVX512F__
+inline Lane16 sqrt(Lane16 v) {
+  return _mm512_maskz_sqrt_ps(0xFFFF, v);
+}  // _mm512_sqrt_ps trips -Wuninitialized in GCC 12
+#endif
 
 template <typename T>
 struct V3 {

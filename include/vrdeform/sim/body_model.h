@@ -27,6 +27,12 @@ struct ConstraintSet {
   static ConstraintSet edgesAndVolume() { return {true, true, false, false}; }
 };
 
+/// The order in which the solver projects a body's constraints.
+enum class SolveOrder {
+  Coloured,  ///< by colour (constraint_colouring.h): SIMD lanes and threads
+  Mesh,      ///< the mesh's order, one at a time: the plain Gauss-Seidel reference
+};
+
 /// Damping time tau = alpha * beta (s) of each constraint type; gamma = tau / h (xpbd.h).
 struct ConstraintDamping {
   float distance = 0, volume = 0, strainStretch = 0, strainShear = 0, bend = 0, shapeMatching = 0;
@@ -47,10 +53,10 @@ struct BodyModel {
   std::vector<BendConstraint> bend;
   std::optional<ShapeMatchModel> shapeMatching;
 
-  /// The first batched* constraints of each array come in groups of kLanes that share no particle
-  /// (lane_batches.h); the solver projects each group at once. Builders order constraints so;
-  /// hand-built models may leave these 0.
-  std::size_t batchedDistance = 0, batchedVolume = 0, batchedStrain = 0;
+  /// Colours (constraint_colouring.h) of the distance array and of the tet-order arrays (volume,
+  /// strain): the solver projects a colour's constraints at once, in SIMD lanes and across threads,
+  /// and the rest one at a time. Empty (hand-built models, SolveOrder::Mesh): all one at a time.
+  std::vector<std::uint32_t> distanceColours, tetColours;
 
   ConstraintDamping damping;
   float particleRadius = 0.0f;  ///< contact offset against colliders (m)
@@ -62,11 +68,13 @@ struct BodyModel {
 /// Builds a soft body from a tet mesh. Throws vrd::Error naming the element for a degenerate or
 /// inverted rest tet, a non-finite coordinate, an out-of-range index or an invalid material.
 std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Material& material,
-                                              const ConstraintSet& constraints = ConstraintSet::paper());
+                                              const ConstraintSet& constraints = ConstraintSet::paper(),
+                                              SolveOrder order = SolveOrder::Coloured);
 
 /// Builds a cloth from a triangle mesh: a distance constraint per edge and a bending constraint
 /// per interior edge. Needs a compliance material (no moduli).
-std::shared_ptr<const BodyModel> makeCloth(const TriMesh& mesh, const Material& material);
+std::shared_ptr<const BodyModel> makeCloth(const TriMesh& mesh, const Material& material,
+                                           SolveOrder order = SolveOrder::Coloured);
 
 /// Appends a distance constraint whose rest length is the rest distance of particles a and b.
 void addDistanceConstraint(BodyModel& model, Index a, Index b, float compliance);

@@ -13,6 +13,21 @@ enum class NanPolicy : std::uint8_t {
   Reset,   ///< put it back at rest in its initial pose and keep simulating
 };
 
+/// How many constraints of one colour the solver projects at once (constraint_colouring.h).
+enum class SimdLevel : std::uint8_t {
+  Off,     ///< one at a time: the plain reference loops
+  Sse,     ///< 4 lanes (SSE, every x86-64)
+  Avx2,    ///< 8 lanes (AVX2 + FMA)
+  Avx512,  ///< 16 lanes (AVX-512F)
+  Best,    ///< the widest this CPU has (checked at run time)
+};
+
+/// Whether this CPU can run `level` (Off, Sse and Best always can).
+bool cpuSupports(SimdLevel level);
+/// `level` with Best replaced by the widest level this CPU supports.
+SimdLevel resolveSimd(SimdLevel level);
+const char* simdName(SimdLevel level);  ///< "off", "sse", "avx2", "avx512" or "best"
+
 struct SolverSettings {
   float timeStep = 1.0f / 60.0f;  ///< dt of one step (s); the paper uses 1/60
   int substeps = 1;               ///< n: each step runs n substeps of h = dt/n ("small steps")
@@ -23,15 +38,17 @@ struct SolverSettings {
   float linearDamping = 0.0f;
   NanPolicy onNan = NanPolicy::Freeze;
   bool timeStages = true;  ///< record per-stage wall-clock times (a few dozen clock reads per step)
-  /// Project independent constraints four at a time in SIMD lanes (the same Gauss-Seidel sweep, up
-  /// to rounding); off runs the plain one-at-a-time loops, the reference.
-  bool simd = true;
+  /// Lanes for each colour's constraints: the same Gauss-Seidel sweep as Off, up to rounding.
+  SimdLevel simd = SimdLevel::Best;
+  /// Threads that share each colour's constraints (OpenMP); the result does not depend on it.
+  /// Worth it for bodies of several thousand tets; 1 runs on the calling thread alone.
+  int threads = 1;
 
   float substepSize() const { return timeStep / float(substeps); }
 };
 
 /// Throws vrd::Error for a non-positive or non-finite time step, substeps or iterations < 1,
-/// non-finite gravity or negative damping.
+/// non-finite gravity, negative damping, threads outside [1, 256] or SIMD this CPU lacks.
 void validateSolverSettings(const SolverSettings& settings);
 
 }  // namespace vrd

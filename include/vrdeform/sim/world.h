@@ -1,6 +1,7 @@
 #pragma once
 // A simulation world: bodies, attachments, colliders and fingertips, stepped with XPBD
-// (Algorithm 1) by one serial Gauss-Seidel solver.
+// (Algorithm 1) by a Gauss-Seidel solver that projects each colour of a body's constraints at once
+// (SIMD lanes, threads) and everything else one at a time.
 
 #include <array>
 #include <cstdint>
@@ -14,6 +15,11 @@
 #include "vrdeform/sim/solver_settings.h"
 
 namespace vrd {
+
+struct SolverTeam;
+namespace sweeps {
+struct LanePlan;
+}
 
 using AttachmentId = std::uint32_t;
 using ColliderId = std::uint32_t;
@@ -133,7 +139,9 @@ class World {
   void detectContacts();
   void detectTriangleContacts();
   void resetMultipliers();
-  void solveIteration(float h);
+  void solveIterations(float h);
+  void solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team);
+  void solveWorldConstraints(float invH, bool timed);
   void finalise(float h);
   void containNonFinite(BodyId id);
 

@@ -1,0 +1,33 @@
+// The one-at-a-time and 4-lane sweeps, with the default flags (any x86-64); see lane_sweeps.h.
+#include "lane_sweeps.h"
+
+namespace vrd::sweeps {
+
+const LaneSweeps& scalarSweeps() {
+  static const LaneSweeps sweeps = makeLaneSweeps<float>();
+  return sweeps;
+}
+
+const LaneSweeps& sseSweeps() {
+  static const LaneSweeps sweeps = makeLaneSweeps<Lane4>();
+  return sweeps;
+}
+
+LanePlan lanePlan(SimdLevel level) {
+  LanePlan plan;
+  switch (resolveSimd(level)) {
+    case SimdLevel::Avx512:
+      plan.widths[plan.count++] = &avx512Sweeps();
+      break;
+    case SimdLevel::Avx2:
+      plan.widths[plan.count++] = &avx2Sweeps();
+      break;
+    default:
+      break;
+  }
+  if (level != SimdLevel::Off) plan.widths[plan.count++] = &sseSweeps();
+  plan.widths[plan.count++] = &scalarSweeps();
+  return plan;
+}
+
+}  // namespace vrd::sweeps
