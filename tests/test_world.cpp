@@ -173,5 +173,22 @@ TEST(World, BodiesSharingAModelAreIndependent) {
   EXPECT_GT((w.particles().x[w.particleIndex(a, 0)].pos - model->restPositions[0]).norm(), 0.1f);
 }
 
+// Issue 6's memory budget: at most 300 bytes per tet, all constraint data, multipliers and
+// particle state included. The count is not vacuous: it grows with the constraints a body has.
+TEST(World, BodyMemoryStaysWithinThreeHundredBytesPerTet) {
+  const TetMesh mesh = makeBoxTets(Vec3::Zero(), Vec3::Ones(), 12, 12, 12);  // 10,368 tets
+  World w;
+  const BodyId light = w.addBody(makeSoftBody(mesh, Material{}, ConstraintSet::edgesAndVolume()));
+  const BodyId paper = w.addBody(makeSoftBody(mesh, Material{}, ConstraintSet::paper()));
+  const double perTet[2] = {double(w.bodyBytes(light)) / double(mesh.tets.size()),
+                            double(w.bodyBytes(paper)) / double(mesh.tets.size())};
+  // Lower bounds from the arrays alone: a volume constraint (24 B) and multiplier (4 B) per tet,
+  // and for the paper's set a strain constraint (60 B) and six multipliers (24 B) more.
+  EXPECT_GT(perTet[0], 28.0);
+  EXPECT_GT(perTet[1], perTet[0] + 60.0);
+  EXPECT_LE(perTet[0], 300.0);
+  EXPECT_LE(perTet[1], 300.0);
+}
+
 }  // namespace
 }  // namespace vrd

@@ -92,7 +92,7 @@ std::vector<T> permuted(const std::vector<T>& items, const std::vector<Index>& o
 
 // Colours with fewer constraints than this are left to the serial remainder: a colour costs the
 // threads a barrier, and one this small would not fill their SIMD lanes.
-constexpr std::size_t kMinColourSize = 32;
+constexpr std::size_t kMinColourSize = 8;
 
 // Puts the distance constraints in colour order.
 void colourDistances(BodyModel& model, SolveOrder order) {
@@ -259,6 +259,21 @@ std::shared_ptr<const BodyModel> makeCloth(const TriMesh& mesh, const Material& 
   for (std::size_t v = 0; v < used.size(); ++v)
     if (!used[v]) throw Error(fmt::format("vertex {} is not used by any triangle; remove unused vertices first", v));
   return model;
+}
+
+namespace {
+template <typename T>
+std::size_t bytesOf(const std::vector<T>& v) {
+  return v.capacity() * sizeof(T);
+}
+}  // namespace
+
+std::size_t BodyModel::bytes() const {
+  std::size_t n = bytesOf(restPositions) + bytesOf(invMass) + bytesOf(tets) + bytesOf(triangles) + bytesOf(surface) +
+                  bytesOf(distance) + bytesOf(volume) + bytesOf(strain) + bytesOf(bend) + bytesOf(distanceColours) +
+                  bytesOf(tetColours);
+  if (shapeMatching) n += bytesOf(shapeMatching->restOffsets) + bytesOf(shapeMatching->mass);
+  return n;
 }
 
 void validateModel(const BodyModel& model) {

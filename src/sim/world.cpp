@@ -512,6 +512,14 @@ double World::volume(BodyId id) const {
   return sum;
 }
 
+std::size_t World::bodyBytes(BodyId id) const {
+  const Body& b = bodies_.at(id);
+  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  const std::size_t perParticle = 2 * sizeof(Point) + 2 * sizeof(Vec3);  // x, p, v, force
+  return b.model->bytes() + bytes(b.distanceLambda) + bytes(b.volumeLambda) + bytes(b.strainLambda) +
+         bytes(b.bendLambda) + bytes(b.shapeMatchLambda) + bytes(b.initialPositions) + b.particleCount * perParticle;
+}
+
 double World::volumeLoss(BodyId id) const {
   const double v0 = bodies_.at(id).model->restVolume;
   return v0 > 0.0 ? (v0 - volume(id)) / v0 : 0.0;

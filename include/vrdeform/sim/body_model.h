@@ -63,6 +63,8 @@ struct BodyModel {
   double restVolume = 0.0;      ///< sum of the tets' rest volumes (m^3)
 
   std::size_t particleCount() const { return restPositions.size(); }
+  /// Heap memory of the rest data and constraint arrays (capacity, bytes).
+  std::size_t bytes() const;
 };
 
 /// Builds a soft body from a tet mesh. Throws vrd::Error naming the element for a degenerate or

@@ -125,6 +125,9 @@ class World {
   // --- Measurements -------------------------------------------------------------------------------
   /// Sum of the signed volumes of the body's tets at its current positions (m^3).
   double volume(BodyId id) const;
+  /// Heap memory a body takes (bytes): its model (rest data, constraints, colours), its state
+  /// (multipliers, initial pose) and its particles (positions, predictions, velocities, forces).
+  std::size_t bodyBytes(BodyId id) const;
   /// Volume loss e = (v0 - v)/v0 (paper section 6.1).
   double volumeLoss(BodyId id) const;
   /// Net constraint force on each of the body's particles in the last substep (N):
