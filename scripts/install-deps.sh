@@ -16,6 +16,7 @@ packages=(
   tetgen              # optional mesher, run as a separate program (AGPL)
   libgtest-dev libgmock-dev googletest   # unit tests
   libbenchmark-dev    # benchmarks
+  libbullet-dev       # Bullet soft bodies: only for bench/bullet_compare (not a test)
   clang-format        # code style check
   clang libclang-rt-14-dev   # libFuzzer for the fuzz targets (fuzz/)
 )
