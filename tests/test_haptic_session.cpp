@@ -61,7 +61,11 @@ struct Liver {
     o.targetTets = 800;
     Material m;
     m.elastic = ElasticModuli{3e4f, 0.4f, 1060.0f, 0.005f};
-    body = world.addBody(makeSoftBody(tetrahedralise(surface, o).mesh, m));
+    // In the mesh's Gauss-Seidel order: at the paper's 1 substep x 5 iterations the solver is far
+    // from converged and how smoothly the poke's force rises depends on the order. Spearman rho
+    // (finger, newtons, Algorithm 2) is 0.9996 / 0.997 / 0.949 in the mesh's order and 0.988 /
+    // 0.981 / 0.887 in colours; the scenes, at 8 substeps, converge.
+    body = world.addBody(makeSoftBody(tetrahedralise(surface, o).mesh, m, ConstraintSet::paper(), SolveOrder::Mesh));
     world.addCollider(Collider::plane(Vec3::UnitY()));
     for (int s = 0; s < 90; ++s) world.step();
     top = Vec3(0, -1e9f, 0);
@@ -267,9 +271,8 @@ TEST(HapticSession, LiverPokeForceRisesWithDepthAndReturnsToZero) {
   EXPECT_GE(rhoFinger, 0.99);
   EXPECT_GE(rhoNewtons, 0.99);
   // Algorithm 2's own value averages the multipliers over N(r) (eq. 40), so it dips whenever one
-  // more contact joins the set; it still follows the depth, less strictly. How much it dips
-  // depends on the Gauss-Seidel order at these 5 iterations: 0.983 in the mesh's order, 0.949 in
-  // the coloured order (constraint_colouring.h).
+  // more contact joins the set; it still follows the depth, less strictly (0.983 in the 4-lane
+  // order the solver had before colouring, 0.949 in the mesh's order).
   EXPECT_GE(rhoPaper, 0.93);
   EXPECT_GT(finger.back(), 0.5);
 
