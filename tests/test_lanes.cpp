@@ -155,10 +155,12 @@ std::vector<Vec3> sagBlock(const std::shared_ptr<const BodyModel>& model, const 
   return x;
 }
 
-std::shared_ptr<const BodyModel> dampedBlock(int cells, const ConstraintSet& set, SolveOrder order = SolveOrder::Coloured) {
+std::shared_ptr<const BodyModel> dampedBlock(int cells, const ConstraintSet& set,
+                                             SolveOrder order = SolveOrder::Coloured) {
   Material m;
   m.elastic = ElasticModuli{2e4f, 0.4f, 1000.0f, 0.001f};
-  return makeSoftBody(makeBoxTets(Vec3(-0.05f, 0.0f, -0.05f), Vec3::Constant(0.1f), cells, cells, cells), m, set, order);
+  return makeSoftBody(makeBoxTets(Vec3(-0.05f, 0.0f, -0.05f), Vec3::Constant(0.1f), cells, cells, cells), m, set,
+                      order);
 }
 
 // Every lane width the CPU has computes the same Gauss-Seidel sweep as the one-at-a-time loops;
@@ -195,8 +197,8 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactly) {
 }
 
 // The coloured order is another Gauss-Seidel order: it settles to the same static equilibrium as
-// the mesh's order (with any number of threads: see the test above). A block pinned at one end sags under gravity; with enough iterations both
-// orders converge, and the tip's sag agrees to well within the solver's residual.
+// the mesh's order (with any number of threads: see the test above). A block pinned at one end sags under gravity; with
+// enough iterations both orders converge, and the tip's sag agrees to well within the solver's residual.
 TEST(Lanes, ColouredAndMeshOrderSettleToTheSameEquilibrium) {
   Material m;
   m.elastic = ElasticModuli{1e5f, 0.3f, 1000.0f, 0.0f};
