@@ -36,11 +36,26 @@ GloveLink::GloveLink(const std::string& endpoint, const HandRigSettings& hand, c
              cs.port);
 }
 
+void GloveLink::printEvents() {
+  for (const weart::Event& e : client_.takeEvents()) fmt::print(e.error ? stderr : stdout, "glove: {}\n", e.message);
+}
+
+std::optional<float> GloveLink::closure(Finger finger) const {
+  const auto c = client_.closures();
+  if (!c) return std::nullopt;
+  return (*c)[int(finger)];
+}
+
+bool GloveLink::connected() const {
+  const weart::State s = client_.state();
+  return s == weart::State::Running || s == weart::State::Calibrating;
+}
+
 void GloveLink::afterStep(const HapticFrame& frame, double time) {
   std::array<float, kFingerCount> force{};
   for (int f = 0; f < kFingerCount; ++f) force[f] = frame.fingers[f].force;
   client_.publishForces(force);
-  for (const weart::Event& e : client_.takeEvents()) fmt::print(e.error ? stderr : stdout, "glove: {}\n", e.message);
+  printEvents();
   if (!start_)
     start_ = std::chrono::steady_clock::now() -
              std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(time));

@@ -26,6 +26,15 @@ class GloveLink {
   /// After the step that ends at simulation time `time`: publishes the forces, prints the client's
   /// news and sleeps until that time has passed on the wall clock (from the first call).
   void afterStep(const HapticFrame& frame, double time);
+  /// The forces for the thimbles, without waiting (any thread; `vrdeform serve` calls it from the
+  /// simulation loop's thread every step, which keeps the watchdog quiet).
+  void publishForces(const std::array<float, kFingerCount>& force) { client_.publishForces(force); }
+  /// Prints the client's news (connection changes, errors) since the last call.
+  void printEvents();
+  /// The glove's latest closure of `finger` in [0, 1]; nullopt before its first tracking frame.
+  std::optional<float> closure(Finger finger) const;
+  /// Whether the middleware session runs, so that forces reach the glove.
+  bool connected() const;
   /// Releases the glove and stops the client (also done by the destructor).
   void shutdown() { client_.shutdown(); }
 

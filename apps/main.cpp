@@ -4,8 +4,11 @@
 
 #include "bench_command.h"
 #include "mesh_commands.h"
+#include "render_command.h"
 #include "run_command.h"
+#include "serve_command.h"
 #include "touch_command.h"
+#include "view_command.h"
 #include "vrdeform/error.h"
 
 int main(int argc, char** argv) {
@@ -17,6 +20,9 @@ int main(int argc, char** argv) {
   const auto runMeshCommand = vrd::addMeshCommands(app);
   const auto runTouchCommand = vrd::addTouchCommand(app);
   const auto runBenchCommand = vrd::addBenchCommand(app);
+  const auto runRenderCommand = vrd::addRenderCommand(app);
+  const auto runViewCommand = vrd::addViewCommand(app);
+  const auto runServeCommand = vrd::addServeCommand(app);
 
   // Exit status: 0 fine; 1 a run failed part-way, a mesh has defects or a replay differs; 2 bad
   // input, usage errors included (CLI11's own codes are folded into 2).
@@ -30,6 +36,9 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("mesh")) return runMeshCommand();
     if (app.got_subcommand("touch")) return runTouchCommand();
     if (app.got_subcommand("bench")) return runBenchCommand();
+    if (app.got_subcommand("render")) return runRenderCommand();
+    if (app.got_subcommand("view")) return runViewCommand();
+    if (app.got_subcommand("serve")) return runServeCommand();
   } catch (const vrd::Error& e) {
     fmt::print(stderr, "vrdeform: {}\n", e.what());
     return 2;

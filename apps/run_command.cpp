@@ -10,6 +10,7 @@
 #include <string>
 
 #include "glove_link.h"
+#include "scene_video.h"
 #include "vrdeform/devices/csv_recorder.h"
 #include "vrdeform/devices/osc_output.h"
 #include "vrdeform/devices/stop_signals.h"
@@ -26,6 +27,8 @@ struct RunArgs {
   std::uint64_t steps = 0;
   int substeps = 0, iterations = 0;  // 0: the scene's
   double reportEvery = 0.5;
+  bool render = false;  // --render: frames (and a video) into out
+  VideoOptions video;
 };
 
 std::string fingerList(const std::array<bool, kFingerCount>& fingers) {
@@ -143,6 +146,7 @@ class Progress {
 };
 
 int run(const RunArgs& a) {
+  if (a.render && a.out.empty()) throw Error("--render needs --out DIR for the frames");
   SceneSpec spec = loadSceneByName(a.scene);
   if (a.substeps > 0) spec.solver.substeps = a.substeps;
   if (a.iterations > 0) spec.solver.iterations = a.iterations;
@@ -178,10 +182,20 @@ int run(const RunArgs& a) {
   }
   for (const auto& o : outputs) settings.outputs.push_back(o.get());
   if (glove) settings.input = &glove->input();
+  std::optional<SceneVideo> video;
+  if (a.render) {
+    try {
+      video.emplace(scene, a.out, a.video);
+    } catch (const Error& e) {
+      fmt::print(stderr, "vrdeform: cannot render: {}\n", e.what());
+      return 1;
+    }
+  }
   Progress progress(seconds, a.reportEvery, dt, spec.hand.enabled);
   const StopSignals signals;
   settings.afterStep = [&](const RunStep& s) {
     progress.step(s);
+    if (video) video->afterStep(s);
     if (glove && s.session) glove->afterStep(s.session->haptics(), s.time);
     return !signals.requested();
   };
@@ -199,6 +213,8 @@ int run(const RunArgs& a) {
   if (glove) glove->shutdown();
   if (signals.requested()) fmt::print("stopped by a signal after {} steps\n", summary.steps);
   printSummary(summary, scene);
+  if (video)
+    for (const auto& f : video->finish()) summary.files.push_back(f);
   if (!summary.files.empty()) {
     fmt::print("\nwrote into {}:", a.out);
     for (const auto& f : summary.files) fmt::print(" {}", f.generic_string());
@@ -240,6 +256,9 @@ std::function<int()> addRunCommands(CLI::App& app) {
                   "middleware (default port 13031)");
   run->add_option("--forces", a->forces, "Log every step's per-finger forces with timestamps to this CSV file");
   run->add_option("--osc", a->osc, "Send every step's forces as OSC over UDP to HOST:PORT (docs/outputs.md)");
+  run->add_flag("--render", a->render,
+                "Also draw the run headless into --out: frames/frame_NNNNN.png, and video.mp4 when ffmpeg is on PATH");
+  addVideoOptions(*run, a->video);
   CLI::App* scenes = app.add_subcommand("scenes", "List the built-in scenes");
   return [a, run, scenes]() -> int {
     if (*run) return vrd::run(*a);

@@ -19,7 +19,14 @@ packages=(
   libbullet-dev       # Bullet soft bodies: only for bench/bullet_compare (not a test)
   clang-format        # code style check
   clang libclang-rt-14-dev   # libFuzzer for the fuzz targets (fuzz/)
+  libboost1.81-dev    # Boost.Beast (HTTP, WebSocket) for the VR server (vrdeform serve)
+  chromium            # the VR page's browser test (headless, with an emulated headset)
+  libepoxy-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri   # OpenGL renderer; headless on Mesa's EGL surfaceless
+  libglfw3-dev libimgui-dev libstb-dev   # desktop viewer window and panels; PNG frames
+  xvfb xauth          # the viewer's test under a virtual X server
 )
+
+command -v node >/dev/null || packages+=(nodejs npm)  # the VR page's npm packages and browser test
 
 missing=()
 for p in "${packages[@]}"; do

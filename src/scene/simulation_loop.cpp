@@ -113,24 +113,69 @@ void SimulationLoop::pickUpChannels() {
   channelsChanged_.store(false, std::memory_order_relaxed);
 }
 
+void SimulationLoop::setSolverSettings(const SolverSettings& settings) {
+  SolverSettings s = settings;
+  s.timeStep = float(dt_);  // the loop's rate and the scene's calibration belong to it
+  validateSolverSettings(s);
+  std::lock_guard lock(solverMutex_);
+  pendingSolver_ = s;
+  solverChanged_.store(true, std::memory_order_release);
+}
+
+void SimulationLoop::pickUpSolverSettings() {
+  if (!solverChanged_.load(std::memory_order_acquire)) return;
+  std::unique_lock lock(solverMutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return;  // being set: take it next step
+  if (pendingSolver_) scene_.world->setSettings(*pendingSolver_);
+  pendingSolver_.reset();
+  solverChanged_.store(false, std::memory_order_relaxed);
+}
+
+void SimulationLoop::setPaused(bool paused) { paused_.store(paused, std::memory_order_release); }
+
+void SimulationLoop::requestSteps(std::uint64_t n) { requestedSteps_.fetch_add(n, std::memory_order_acq_rel); }
+
+bool SimulationLoop::mayStep() {
+  if (!paused_.load(std::memory_order_acquire)) return true;
+  std::uint64_t n = requestedSteps_.load(std::memory_order_acquire);
+  while (n > 0 && !requestedSteps_.compare_exchange_weak(n, n - 1, std::memory_order_acq_rel)) {
+  }
+  return n > 0;
+}
+
+void SimulationLoop::nap() {
+  std::unique_lock lock(sleepMutex_);
+  wake_.wait_for(lock, std::chrono::milliseconds(1), [this] { return stopRequested_.load(std::memory_order_relaxed); });
+}
+
 void SimulationLoop::run() {
   const double periodMs = 1e3 * period();
   Clock::time_point origin = Clock::now();  // of the real-time schedule
   std::uint64_t sinceOrigin = 0;            // steps started since origin
   firstStart_ = lastStart_ = origin;
   try {
-    for (std::uint64_t k = 0; settings_.maxSteps == 0 || k < settings_.maxSteps; ++k) {
-      if (k > 0 && settings_.realTime) pace(origin, sinceOrigin);
+    std::uint64_t k = 0;
+    for (bool first = true; settings_.maxSteps == 0 || k < settings_.maxSteps; first = false) {
+      if (!first && settings_.realTime) pace(origin, sinceOrigin);
       if (stopRequested_.load(std::memory_order_acquire)) break;
+      if (!mayStep()) {  // paused: a real-time loop keeps its schedule, another one naps
+        if (!settings_.realTime) nap();
+        continue;
+      }
       lastStart_ = Clock::now();
-      if (k == 0) firstStart_ = origin = lastStart_;
+      if (k == 0) {
+        firstStart_ = origin = lastStart_;
+        sinceOrigin = 0;
+      }
       pickUpChannels();
+      pickUpSolverSettings();
       step(k);
       publish(k, msSince(lastStart_));
       const double workMs = msSince(lastStart_);
       if (stepMs_.size() < settings_.latencyFrames) stepMs_.push_back(workMs);
       if (workMs > periodMs) overruns_.fetch_add(1, std::memory_order_relaxed);
       steps_.store(k + 1, std::memory_order_release);
+      ++k;
     }
   } catch (...) {
     error_ = std::current_exception();
@@ -169,34 +214,7 @@ void SimulationLoop::publish(std::uint64_t k, double stepWallMs) {
 }
 
 void SimulationLoop::fill(Snapshot& s, std::uint64_t k, double stepWallMs) const {
-  const World& world = *scene_.world;
-  s.step = k + 1;
-  s.time = double(k + 1) * dt_;
-  const std::vector<Point>& x = world.particles().x;
-  s.positions.resize(x.size());
-  for (std::size_t i = 0; i < x.size(); ++i) s.positions[i] = x[i].pos;
-  s.bodyFirst.resize(world.bodyCount());
-  for (std::size_t b = 0; b < s.bodyFirst.size(); ++b) s.bodyFirst[b] = world.body(BodyId(b)).firstParticle;
-  s.fingerPresent = {};
-  s.fingertips.fill(Vec3::Zero());
-  s.fingertipRadius = 0.0f;
-  if (session_) {
-    const HandRig& rig = session_->rig();
-    for (int f = 0; f < kFingerCount; ++f)
-      if (rig.has(Finger(f))) {
-        s.fingerPresent[f] = true;
-        s.fingertips[f] = world.fingertip(rig.fingertip(Finger(f))).center;
-      }
-    s.fingertipRadius = scene_.session.hand.geometry.fingertipRadius;
-    s.haptics = session_->haptics();
-    s.grasping = session_->grasp().active();
-  } else {
-    s.haptics = {};
-    s.grasping = false;
-  }
-  s.contact = contact_;
-  s.times = session_ ? session_->times() : world.lastStep().times;
-  s.stepWallMs = stepWallMs;
+  captureSnapshot(s, *scene_.world, session_ ? &*session_ : nullptr, k + 1, double(k + 1) * dt_, stepWallMs);
 }
 
 void SimulationLoop::pace(Clock::time_point& origin, std::uint64_t& sinceOrigin) {

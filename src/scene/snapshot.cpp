@@ -1,6 +1,40 @@
 #include "vrdeform/scene/snapshot.h"
 
+#include "vrdeform/haptics/haptic_session.h"
+
 namespace vrd {
+
+void captureSnapshot(Snapshot& s, const World& world, const HapticSession* session, std::uint64_t step, double time,
+                     double stepWallMs) {
+  s.step = step;
+  s.time = time;
+  const std::vector<Point>& x = world.particles().x;
+  s.positions.resize(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) s.positions[i] = x[i].pos;
+  s.bodyFirst.resize(world.bodyCount());
+  for (std::size_t b = 0; b < s.bodyFirst.size(); ++b) s.bodyFirst[b] = world.body(BodyId(b)).firstParticle;
+  s.fingerPresent = {};
+  s.fingertips.fill(Vec3::Zero());
+  s.fingertipRadius = 0.0f;
+  s.haptics = {};
+  s.grasping = false;
+  s.contact = false;
+  if (session) {
+    const HandRig& rig = session->rig();
+    for (int f = 0; f < kFingerCount; ++f)
+      if (rig.has(Finger(f))) {
+        const Fingertip& tip = world.fingertip(rig.fingertip(Finger(f)));
+        s.fingerPresent[f] = true;
+        s.fingertips[f] = tip.center;
+        s.fingertipRadius = tip.radius;
+      }
+    s.haptics = session->haptics();
+    s.grasping = session->grasp().active();
+    s.contact = session->inContact();
+  }
+  s.times = session ? session->times() : world.lastStep().times;
+  s.stepWallMs = stepWallMs;
+}
 
 SnapshotChannel::SnapshotChannel(std::size_t particles, std::size_t bodies) {
   for (Snapshot& s : slots_) {

@@ -96,6 +96,17 @@ class SimulationLoop {
   std::shared_ptr<SnapshotChannel> subscribe();
   /// Stops sending to `channel` (from a later step on, as subscribe()).
   void unsubscribe(const std::shared_ptr<SnapshotChannel>& channel);
+  /// Pauses the stepping (true) or resumes it, from the next period on. A paused loop publishes
+  /// nothing and, in real time, keeps its schedule (no burst on resuming); the time it spends
+  /// paused counts in LoopStats' wall time.
+  void setPaused(bool paused);
+  bool paused() const { return paused_.load(std::memory_order_acquire); }
+  /// While paused: runs `n` more steps, one per period (single-stepping).
+  void requestSteps(std::uint64_t n = 1);
+  /// Changes the solver's settings (iterations, substeps, damping, ...) from the start of a later
+  /// step, applied on the loop thread as subscribe() is picked up; the time step stays the loop's.
+  /// Throws vrd::Error for invalid settings, at once on the calling thread.
+  void setSolverSettings(const SolverSettings& settings);
 
  private:
   using Clock = std::chrono::steady_clock;
@@ -105,6 +116,9 @@ class SimulationLoop {
   void publish(std::uint64_t k, double stepWallMs);
   void fill(Snapshot& s, std::uint64_t k, double stepWallMs) const;
   void pickUpChannels();
+  void pickUpSolverSettings();
+  bool mayStep();  // not paused, or a requested step is left (taken)
+  void nap();      // a paused loop that is not paced waits a millisecond (stop() wakes it)
   void pace(Clock::time_point& origin, std::uint64_t& sinceOrigin);
   void requireStopped(const char* what) const;
 
@@ -120,6 +134,13 @@ class SimulationLoop {
   std::vector<std::shared_ptr<SnapshotChannel>> wanted_;
   std::atomic<bool> channelsChanged_{false};
   std::vector<std::shared_ptr<SnapshotChannel>> channels_;
+
+  // Solver settings to apply: under the same kind of mutex, try_locked by the loop thread.
+  std::mutex solverMutex_;
+  std::optional<SolverSettings> pendingSolver_;
+  std::atomic<bool> solverChanged_{false};
+  std::atomic<bool> paused_{false};
+  std::atomic<std::uint64_t> requestedSteps_{0};
 
   // Loop thread while running; the controlling thread after the join.
   LatencyRecorder latency_;

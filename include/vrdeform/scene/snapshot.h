@@ -14,6 +14,8 @@
 
 namespace vrd {
 
+class HapticSession;
+
 /// The world after one step of a SimulationLoop.
 struct Snapshot {
   std::uint64_t step = 0;                ///< steps the loop had run, this one included; 0: none yet
@@ -30,6 +32,12 @@ struct Snapshot {
   StageTimes times;                                ///< per-stage times of this step
   double stepWallMs = 0.0;                         ///< wall time of input, simulation and outputs (ms)
 };
+
+/// Fills `s` with `world` as it is after its `step`-th step (1-based), at simulated time `time`, and
+/// `session`'s hand and haptic signal (none when null): what the loop publishes, also usable by a
+/// caller that steps the world itself (headless rendering). Reuses the vectors' capacity.
+void captureSnapshot(Snapshot& s, const World& world, const HapticSession* session, std::uint64_t step, double time,
+                     double stepWallMs = 0.0);
 
 /// A triple buffer from the loop thread to one reader. The writer fills back() and publish()es it;
 /// the reader's update() swaps in the newest published slot. Each side owns one slot, the third

@@ -1,0 +1,169 @@
+#include "serve_command.h"
+
+#include <arpa/inet.h>
+#include <fmt/format.h>
+#include <ifaddrs.h>
+#include <netinet/in.h>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "glove_link.h"
+#include "vrdeform/devices/stop_signals.h"
+#include "vrdeform/error.h"
+#include "vrdeform/scene/scene_library.h"
+#include "vrdeform/web/static_files.h"
+#include "vrdeform/web/vr_server.h"
+
+namespace vrd {
+namespace {
+
+struct ServeArgs {
+  std::string scene, bind = "127.0.0.1", weart;
+  std::uint16_t port = 8080;
+  double frameRate = 72.0;
+  double seconds = 0.0;  // 0: until Ctrl-C
+};
+
+// The glove as one of the loop's outputs: every step's forces, published without waiting.
+class GloveForces final : public HapticOutput {
+ public:
+  explicit GloveForces(GloveLink& glove) : glove_(glove) {}
+  void send(const HapticSample& sample) override { glove_.publishForces(sample.force); }
+  void release() override { glove_.publishForces({}); }
+
+ private:
+  GloveLink& glove_;
+};
+
+// The machine's IPv4 addresses other than loopback: what a headset on the LAN opens.
+std::vector<std::string> lanAddresses() {
+  std::vector<std::string> out;
+  ifaddrs* list = nullptr;
+  if (::getifaddrs(&list) != 0) return out;
+  for (const ifaddrs* a = list; a; a = a->ifa_next) {
+    if (!a->ifa_addr || a->ifa_addr->sa_family != AF_INET) continue;
+    char text[INET_ADDRSTRLEN] = {};
+    const auto* in = reinterpret_cast<const sockaddr_in*>(a->ifa_addr);
+    if (::inet_ntop(AF_INET, &in->sin_addr, text, sizeof text) && std::string_view(text).substr(0, 4) != "127.")
+      out.emplace_back(text);
+  }
+  ::freeifaddrs(list);
+  return out;
+}
+
+void printAddresses(const ServeArgs& a, std::uint16_t port) {
+  const bool everywhere = a.bind == "0.0.0.0" || a.bind == "::";
+  const std::string local = everywhere || a.bind == "127.0.0.1" ? "127.0.0.1" : a.bind;
+  fmt::print("serving on http://{}:{}/ (Ctrl-C stops)\n", local, port);
+  if (local == "127.0.0.1")
+    fmt::print("  a Quest over USB: adb reverse tcp:{0} tcp:{0}, then open http://localhost:{0}/ in its browser\n",
+               port);
+  if (everywhere)
+    for (const std::string& ip : lanAddresses())
+      fmt::print("  on the local network: http://{}:{}/ (not a secure context: see docs/vr.md for WebXR)\n", ip, port);
+  std::fflush(stdout);
+}
+
+int serve(const ServeArgs& a) {
+  const SceneSpec spec = loadSceneByName(a.scene);
+  fmt::print("scene {}: {}\n", spec.name, spec.description);
+  std::fflush(stdout);
+  BuiltScene scene = buildScene(spec);
+  const std::filesystem::path web = webFolder();
+  if (!hasThreeJs(web))
+    fmt::print(stderr,
+               "vrdeform: warning: {}/node_modules/three is missing (scripts/install-web.sh installs it); "
+               "the page cannot draw without it\n",
+               web.string());
+
+  VrServerSettings vs;
+  vs.bind = a.bind;
+  vs.port = a.port;
+  vs.frameRate = a.frameRate;
+  vs.hand.park = scene.bodies.front().top + Vec3(0.0f, 0.15f, 0.0f);
+  const float radius = scene.session.hand.geometry.fingertipRadius;
+  std::optional<LiveHandInput> hand;
+  if (spec.hand.enabled) hand.emplace(xrParkedFrame(vs.hand, radius));
+
+  std::optional<GloveLink> glove;
+  std::optional<GloveForces> gloveForces;
+  SimulationLoopSettings ls;
+  if (!a.weart.empty()) {
+    if (!spec.hand.enabled) throw Error(fmt::format("scene {} has no hand for the glove", spec.name));
+    glove.emplace(a.weart, scene.session.hand, scene.bodies.front().top);
+    gloveForces.emplace(*glove);
+    ls.outputs.push_back(&*gloveForces);
+    vs.gloveClosure = [&glove] { return glove->closure(Finger::Index); };
+    vs.gloveConnected = [&glove] { return glove->connected(); };
+  }
+  ls.input = hand ? &*hand : nullptr;
+  SimulationLoop loop(scene, ls);
+  VrServer server(loop, scene, web, vs, hand ? &*hand : nullptr);
+  server.start();
+  loop.start();
+  fmt::print("simulating at {:g} Hz, {} frames/s to viewers; the page: {}\n", 1.0 / loop.period(), a.frameRate,
+             (web / "public").string());
+  printAddresses(a, server.port());
+
+  const StopSignals signals;
+  const auto start = std::chrono::steady_clock::now();
+  while (loop.running() && !signals.requested()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (glove) glove->printEvents();
+    if (a.seconds > 0 && std::chrono::steady_clock::now() - start > std::chrono::duration<double>(a.seconds)) break;
+  }
+  server.stop();
+  int status = 0;
+  try {
+    loop.stop();
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "vrdeform: the simulation failed: {}\n", e.what());
+    status = 1;
+  }
+  if (glove) glove->shutdown();
+  const VrServerStats s = server.stats();
+  const LoopStats ls2 = loop.stats();
+  fmt::print(
+      "\nserved {} viewer(s): {} frames sent, {} skipped for slow viewers, {} MB; {} inputs, {} messages rejected, "
+      "{} viewer(s) dropped\n",
+      s.viewersTotal, s.framesSent, s.framesSkipped, double(s.bytesSent) / 1e6, s.inputs, s.messagesRejected,
+      s.viewersDropped);
+  fmt::print("simulation: {} steps at {:.1f} Hz, {} overruns, step {:.3f} ms mean, {:.3f} ms p99\n", ls2.steps,
+             ls2.achievedRate, ls2.overruns, ls2.stepMs.mean, ls2.stepMs.p99);
+  return status;
+}
+
+}  // namespace
+
+std::function<int()> addServeCommand(CLI::App& app) {
+  auto a = std::make_shared<ServeArgs>();
+  CLI::App* serve = app.add_subcommand(
+      "serve", "Run a scene in real time and serve the VR page (WebXR) on which a headset shows and drives it");
+  serve->add_option("scene", a->scene, "A built-in scene (`vrdeform scenes`) or a scene file (.toml)")->required();
+  serve->add_option("--port", a->port, "TCP port of the page and its WebSocket (0: any free one)")
+      ->capture_default_str();
+  serve
+      ->add_option("--bind", a->bind,
+                   "Address to listen on; 0.0.0.0 serves the local network (prints the addresses to open)")
+      ->capture_default_str();
+  serve->add_option("--fps", a->frameRate, "Frames per second sent to the viewers at most")
+      ->check(CLI::Range(1.0, 1000.0))
+      ->capture_default_str();
+  serve->add_option("--seconds", a->seconds, "Stop after this many seconds (default: at Ctrl-C)")
+      ->check(CLI::Range(0.0, 1e9));
+  serve->add_option("--weart", a->weart,
+                    "Send the forces to a WEART glove and close the hand with it: HOST[:PORT] of the middleware "
+                    "(default port 13031); without a glove the controllers vibrate with the force");
+  return [a, serve]() -> int {
+    if (*serve) return vrd::serve(*a);
+    return 0;
+  };
+}
+
+}  // namespace vrd

@@ -1,0 +1,203 @@
+// The VR page end to end: `vrdeform serve liver`, headless Chromium (Debian's, driven by
+// playwright-core) with an emulated Quest (iwer, installed over Chromium's own navigator.xr). The
+// page enters an immersive-vr session and draws the liver in both eyes; mesh frames keep
+// arriving; the emulated right controller is lowered onto the liver (the server reports a force
+// and, with no glove connected, the controller vibrates) and then closes its trigger on a ridge
+// (the server reports a grasp). Usage: node vr.test.mjs [VRDEFORM] (or $VRDEFORM).
+import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
+import { mkdtempSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import path from 'node:path';
+import { test } from 'node:test';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const vrdeform = process.argv[2] || process.env.VRDEFORM || path.resolve(here, '../../build/release/apps/vrdeform');
+const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
+const iwerScript = path.resolve(here, '../node_modules/iwer/build/iwer.js');
+
+// The controller mapping's defaults (docs/vr.md#hand-input): the pinch's middle is `reach` ahead
+// of the controller; the index sits half the open gap plus a fingertip radius above it (along the
+// controller's up).
+const REACH = 0.03;
+const OPEN_HALF = 0.03;
+// A controller pointing straight down with its up along +x ([x, y, z, w]): the pinch closes
+// along x, as the scene's scripted grasp does.
+const POINTING_DOWN = [-0.5, -0.5, -0.5, 0.5];
+const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+
+async function until(what, check, timeoutMs = 10000) {
+  const end = Date.now() + timeoutMs;
+  let last;
+  while (Date.now() < end) {
+    last = await check();
+    if (last) return last;
+    await sleep(50);
+  }
+  throw new Error(`timed out after ${timeoutMs} ms waiting for ${what}`);
+}
+
+function startServer() {
+  const server = spawn(vrdeform, ['serve', 'liver', '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
+  let output = '';
+  const exited = new Promise((resolve) => server.on('exit', (code, signal) => resolve({ code, signal })));
+  const url = new Promise((resolve, reject) => {
+    const timer = setTimeout(() => reject(new Error(`vrdeform serve did not start in 90 s:\n${output}`)), 90000);
+    server.stdout.on('data', (chunk) => {
+      output += chunk;
+      const m = output.match(/serving on (http:\/\/127\.0\.0\.1:\d+\/)/);
+      if (m) {
+        clearTimeout(timer);
+        resolve(m[1]);
+      }
+    });
+    server.stderr.on('data', (chunk) => (output += chunk));
+    exited.then(({ code }) => {
+      clearTimeout(timer);
+      reject(new Error(`vrdeform serve exited with ${code}:\n${output}`));
+    });
+  });
+  return { server, url, exited, output: () => output };
+}
+
+test('the VR page in an emulated headset: both eyes, mesh frames, poke and grasp', { timeout: 150000 }, async (t) => {
+  const { server, url, exited, output } = startServer();
+  const profile = mkdtempSync(path.join(tmpdir(), 'vrdeform-chromium-'));
+  let browser;
+  t.after(async () => {
+    if (browser) await browser.close().catch(() => {});
+    if (server.exitCode === null) server.kill('SIGKILL');
+    rmSync(profile, { recursive: true, force: true });
+  });
+  const base = await url;
+  const status = async () => (await fetch(`${base}status.json`)).json();
+
+  const context = await chromium.launchPersistentContext(profile, {
+    executablePath: chromiumPath,
+    headless: true,
+    viewport: { width: 800, height: 450 },
+    args: [
+      '--no-sandbox',
+      '--disable-gpu',
+      '--disable-background-networking',
+      '--disable-dev-shm-usage',
+      '--use-angle=swiftshader',
+      '--enable-unsafe-swiftshader',
+    ],
+  });
+  browser = context;
+  const page = context.pages()[0] || (await context.newPage());
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  page.on('console', (m) => m.type() === 'error' && errors.push(m.text()));
+  // The emulated Quest 3, stereo, looking down at the table; before any of the page's scripts.
+  await page.addInitScript({ path: iwerScript });
+  await page.addInitScript(() => {
+    const device = new IWER.XRDevice(IWER.metaQuest3, { stereoEnabled: true });
+    device.installRuntime({ forceInstall: true });
+    device.quaternion.set(-Math.sin(Math.PI / 12), 0, 0, Math.cos(Math.PI / 12)); // 30 degrees down
+    window.__xrDevice = device;
+  });
+  await page.goto(base);
+  await until('the scene and mesh frames', () => page.evaluate(() => vrdeform.state.framesReceived > 3), 30000);
+  const scene = await page.evaluate(() => vrdeform.state.scene);
+  assert.equal(scene.name, 'liver');
+  assert.deepEqual(scene.fingers, ['thumb', 'index', 'middle']);
+
+  // Enter VR with the page's own button.
+  await page.click('#VRButton');
+  await until('an immersive-vr session', () => page.evaluate(() => vrdeform.state.xrPresenting && vrdeform.state.xrFrames > 10));
+
+  // Both eyes: the left and the right half of the canvas each show liver-coloured pixels.
+  const eyes = await page.evaluate(
+    () =>
+      new Promise((resolve) => {
+        vrdeform.afterRender = (gl, presenting) => {
+          if (!presenting) return;
+          vrdeform.afterRender = null;
+          const w = gl.drawingBufferWidth, h = gl.drawingBufferHeight;
+          const px = new Uint8Array(4 * w * h);
+          gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+          const body = [0, 0];
+          for (let i = 0; i < w * h; ++i) {
+            const [r, g, b] = [px[4 * i], px[4 * i + 1], px[4 * i + 2]];
+            if (r > 80 && r > 1.6 * g && r > 1.6 * b) body[i % w < w / 2 ? 0 : 1]++;
+          }
+          resolve({ w, h, left: body[0], right: body[1] });
+        };
+      }),
+  );
+  const half = (eyes.w * eyes.h) / 2;
+  assert.ok(eyes.left > 0.005 * half, `left eye: ${eyes.left} liver pixels of ${half}`);
+  assert.ok(eyes.right > 0.005 * half, `right eye: ${eyes.right} liver pixels of ${half}`);
+
+  // Mesh frames keep coming while in VR.
+  const frames0 = await page.evaluate(() => vrdeform.state.framesReceived);
+  const step0 = (await status()).step;
+  await until('mesh frames in VR', () => page.evaluate((n) => vrdeform.state.framesReceived > n + 5, frames0)).catch(
+    async (e) => assert.fail(`${e.message}: ${JSON.stringify(await page.evaluate(() => vrdeform.state))}`),
+  );
+  assert.ok((await status()).step > step0);
+
+  // Moves the emulated right controller so that its pinch middle sweeps from 4 cm above `middle`
+  // (scene coordinates) down onto it.
+  const lower = async (middle, ms) => {
+    for (let k = 0; k <= 20; ++k) {
+      const above = 0.04 * (1 - k / 20);
+      const ray = [middle[0], middle[1] + REACH + above, middle[2]];
+      await page.evaluate(
+        ({ ray, q }) => {
+          const [x, y, z] = vrdeform.toXr(ray);
+          const c = __xrDevice.controllers.right;
+          c.position.set(x, y, z);
+          c.quaternion.set(...q);
+        },
+        { ray, q: POINTING_DOWN },
+      );
+      await sleep(ms / 20);
+    }
+  };
+  const radius = scene.fingertipRadius;
+  const poke = scene.actions.find((a) => a.kind === 'poke').target;
+  const grasp = scene.actions.find((a) => a.kind === 'grasp').target;
+  const depth = 0.012; // of the fingertip's lowest point below the target, as the scripted actions
+
+  // Poke: the index comes down onto the poke target.
+  await lower([poke[0] - OPEN_HALF - radius, poke[1] + radius - depth, poke[2]], 1000);
+  const poked = await until('a force on the server', async () => {
+    const s = await status();
+    return s.driven && s.contact && Math.max(...s.force) > 0.05 && Math.max(...s.newtons) > 0 ? s : null;
+  });
+  assert.ok(poked.force[1] > 0.05 || poked.force[2] > 0.05, `the index or the middle presses: ${poked.force}`);
+  await until('the page to show the force', () => page.evaluate(() => Math.max(...vrdeform.state.force) > 0.05));
+  await until('a controller pulse (no glove)', () => page.evaluate(() => vrdeform.state.pulses > 0));
+
+  // Up and over to the ridge, then down and close the trigger: a pinch grasp.
+  await lower([grasp[0], grasp[1] + 0.05, grasp[2]], 300);
+  await lower([grasp[0], grasp[1] + radius - depth, grasp[2]], 600);
+  // Closing slowly: a grasp starts in a step where both fingertips touched and the gap shrinks.
+  for (let k = 1; k <= 30; ++k) {
+    await page.evaluate((v) => __xrDevice.controllers.right.updateButtonValue('trigger', v), k / 30);
+    await sleep(50);
+  }
+  const held = await until('a grasp on the server', async () => {
+    const s = await status();
+    return s.grasping ? s : null;
+  }).catch(async (e) => assert.fail(`${e.message}: ${JSON.stringify(await status())}`));
+  assert.ok(held.driven);
+  await until('the page to show the grasp', () => page.evaluate(() => vrdeform.state.grasping));
+
+  assert.deepEqual(errors, [], `page errors: ${errors.join('\n')}`);
+  const stats = (await status()).stats;
+  assert.equal(stats.messagesRejected, 0, 'the page sends only valid messages');
+  assert.ok(stats.inputs > 50, `inputs: ${stats.inputs}`);
+
+  // The server stops cleanly on SIGTERM.
+  await context.close();
+  browser = null;
+  server.kill('SIGTERM');
+  const { code } = await exited;
+  assert.equal(code, 0, output());
+});
