@@ -10,6 +10,7 @@
 #include <string>
 
 #include "vrdeform/devices/glove_input.h"
+#include "vrdeform/devices/haptic_output.h"
 #include "vrdeform/devices/weart_client.h"
 #include "vrdeform/haptics/haptic_model.h"
 
@@ -26,9 +27,9 @@ class GloveLink {
   /// After the step that ends at simulation time `time`: publishes the forces, prints the client's
   /// news and sleeps until that time has passed on the wall clock (from the first call).
   void afterStep(const HapticFrame& frame, double time);
-  /// The forces for the thimbles, without waiting (any thread; `vrdeform serve` calls it from the
-  /// simulation loop's thread every step, which keeps the watchdog quiet).
-  void publishForces(const std::array<float, kFingerCount>& force) { client_.publishForces(force); }
+  /// The thimbles as one of a `SimulationLoop`'s outputs (viewer, VR server): each step's forces,
+  /// published from the loop's thread without waiting, which also keeps the watchdog quiet.
+  HapticOutput& output() { return output_; }
   /// Prints the client's news (connection changes, errors) since the last call.
   void printEvents();
   /// The glove's latest closure of `finger` in [0, 1]; nullopt before its first tracking frame.
@@ -39,7 +40,15 @@ class GloveLink {
   void shutdown() { client_.shutdown(); }
 
  private:
+  struct Output final : HapticOutput {
+    explicit Output(weart::Client& c) : client(c) {}
+    void send(const HapticSample& sample) override { client.publishForces(sample.force); }
+    void release() override { client.publishForces({}); }
+    weart::Client& client;
+  };
+
   weart::Client client_;
+  Output output_{client_};
   std::optional<weart::GloveInput> input_;
   std::string name_;
   std::optional<std::chrono::steady_clock::time_point> start_;

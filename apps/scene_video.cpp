@@ -39,10 +39,12 @@ void addVideoOptions(CLI::App& command, VideoOptions& options) {
           "--color-map",
           [&options](const std::string& s) {
             const std::optional<ColorMap> map = parseColorMap(s);
-            if (!map) throw CLI::ValidationError("--color-map", "expected none, strain or volume, got '" + s + "'");
+            if (!map)
+              throw CLI::ValidationError("--color-map", "expected none, strain, volume or force, got '" + s + "'");
             options.colorMap = *map;
           },
-          "Colour the bodies by: none, strain (edge stretch) or volume (volume change)")
+          "Colour the bodies by: none, strain (edge stretch), volume (volume change) or force (each particle's "
+          "constraint force, N)")
       ->type_name("MAP");
 }
 
@@ -51,6 +53,8 @@ SceneVideo::SceneVideo(const BuiltScene& scene, const std::filesystem::path& dir
   settings_.colorMap = options.colorMap;
   // Framed as the bodies lie now, settled.
   captureSnapshot(snapshot_, *scene.world, nullptr, 0, 0.0);
+  captureConstraintForces(snapshot_, *scene.world);
+  settings_.colorRange = defaultColorRange(options.colorMap, snapshot_);
   renderer_.render(snapshot_, camera_, settings_);
   camera_ = renderer_.framingCamera();
   fmt::print("rendering {}x{} frames at {:g} fps with {}\n", options.width, options.height, options.fps,
@@ -63,6 +67,7 @@ void SceneVideo::afterStep(const RunStep& step) {
   if (step.time + 0.5 * dt < double(recorder_.frames()) / options_.fps) return;
   const auto start = std::chrono::steady_clock::now();
   captureSnapshot(snapshot_, *scene_.world, step.session, step.step + 1, step.time);
+  if (options_.colorMap == ColorMap::ConstraintForce) captureConstraintForces(snapshot_, *scene_.world);
   const Image image = renderer_.render(snapshot_, camera_, settings_);
   renderMs_ += msSince(start);
   const auto written = std::chrono::steady_clock::now();

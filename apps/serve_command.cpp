@@ -30,17 +30,6 @@ struct ServeArgs {
   double seconds = 0.0;  // 0: until Ctrl-C
 };
 
-// The glove as one of the loop's outputs: every step's forces, published without waiting.
-class GloveForces final : public HapticOutput {
- public:
-  explicit GloveForces(GloveLink& glove) : glove_(glove) {}
-  void send(const HapticSample& sample) override { glove_.publishForces(sample.force); }
-  void release() override { glove_.publishForces({}); }
-
- private:
-  GloveLink& glove_;
-};
-
 // The machine's IPv4 addresses other than loopback: what a headset on the LAN opens.
 std::vector<std::string> lanAddresses() {
   std::vector<std::string> out;
@@ -92,13 +81,11 @@ int serve(const ServeArgs& a) {
   if (spec.hand.enabled) hand.emplace(xrParkedFrame(vs.hand, radius));
 
   std::optional<GloveLink> glove;
-  std::optional<GloveForces> gloveForces;
   SimulationLoopSettings ls;
   if (!a.weart.empty()) {
     if (!spec.hand.enabled) throw Error(fmt::format("scene {} has no hand for the glove", spec.name));
     glove.emplace(a.weart, scene.session.hand, scene.bodies.front().top);
-    gloveForces.emplace(*glove);
-    ls.outputs.push_back(&*gloveForces);
+    ls.outputs.push_back(&glove->output());
     vs.gloveClosure = [&glove] { return glove->closure(Finger::Index); };
     vs.gloveConnected = [&glove] { return glove->connected(); };
   }

@@ -24,6 +24,7 @@ packages=(
   libepoxy-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri   # OpenGL renderer; headless on Mesa's EGL surfaceless
   libglfw3-dev libimgui-dev libstb-dev   # desktop viewer window and panels; PNG frames
   xvfb xauth          # the viewer's test under a virtual X server
+  ffmpeg              # MP4 from headless frames (vrdeform render; optional at run time)
 )
 
 command -v node >/dev/null || packages+=(nodejs npm)  # the VR page's npm packages and browser test

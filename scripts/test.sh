@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Builds and runs every test: installs what is missing, configures the preset (default: release;
-# also debug, asan, tsan). VRDEFORM_WERROR=ON makes warnings errors., builds everything and runs CTest on both cores.
+# Builds everything and runs every test on all cores: installs what is missing, configures the
+# preset (default: release; also debug, asan, tsan). VRDEFORM_WERROR=ON makes warnings errors.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset="${1:-release}"

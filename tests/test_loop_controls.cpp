@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <thread>
 
 #include "vrdeform/error.h"
@@ -60,6 +62,35 @@ TEST(LoopControls, PausedLoopStepsOnlyWhenAsked) {
   loop.setPaused(true);
   loop.stop();  // a paused loop stops at once
   EXPECT_FALSE(loop.running());
+}
+
+TEST(LoopControls, SnapshotsCarryConstraintForcesOnlyWhenAsked) {
+  BuiltScene scene = liver();
+  SimulationLoopSettings settings;
+  settings.realTime = false;
+  SimulationLoop loop(scene, settings);
+  loop.setPaused(true);
+  auto view = loop.subscribe();
+  loop.start();
+  loop.requestSteps(1);
+  ASSERT_TRUE(eventually([&] { return view->update() && view->front().step == 1; }));
+  EXPECT_TRUE(view->front().constraintForce.empty());  // off by default: it costs an iteration
+  loop.setConstraintForces(true);
+  loop.requestSteps(30);  // placed on the ground: by then it presses on it
+  ASSERT_TRUE(eventually([&] { return view->update() && view->front().step == 31; }));
+  const Snapshot& s = view->front();
+  ASSERT_EQ(s.constraintForce.size(), s.positions.size());
+  float largest = 0.0f;
+  for (float f : s.constraintForce) {
+    ASSERT_TRUE(std::isfinite(f));
+    largest = std::max(largest, f);
+  }
+  EXPECT_GT(largest, 0.0f);  // its constraints carry its weight
+  loop.setConstraintForces(false);
+  loop.requestSteps(1);
+  ASSERT_TRUE(eventually([&] { return view->update() && view->front().step == 32; }));
+  EXPECT_TRUE(view->front().constraintForce.empty());
+  loop.stop();
 }
 
 TEST(LoopControls, SolverSettingsChangeBetweenSteps) {

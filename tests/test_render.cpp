@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -185,6 +186,46 @@ TEST(Render, HeadlessLiverIsVisibleAndAPokeChangesItWhereItPressed) {
   ASSERT_TRUE(tip);
   EXPECT_GT(meanDifference(after, hand, int(tip->x()) - 2, int(tip->y()) - 2, int(tip->x()) + 2, int(tip->y()) + 2),
             10.0);
+}
+
+// The force map (World::particleMaterialForces): at rest the material's net force on a particle
+// balances its weight plus its contacts, so under the pressing index, where the push and the weight
+// point the same way, the map adds up to the finger's force more than before the poke.
+TEST(Render, ForceMapShowsWhereTheFingerPresses) {
+  BuiltScene scene = liver();
+  PosedScene posed(scene);
+  Snapshot rest, poked;
+  captureSnapshot(rest, *scene.world, nullptr, 0, 0.0);
+  posed.pose(rest, ColorMap::ConstraintForce);  // without forces in the snapshot: nothing to show
+  EXPECT_EQ(maxDeviation(posed.values(0), 0.0f), 0.0f);
+  captureConstraintForces(rest, *scene.world);
+
+  HapticSession session(*scene.world, scene.session, scene.input->frame(0, 0.0));
+  const double dt = scene.world->settings().timeStep;
+  std::uint64_t k = 0;
+  for (; double(k) * dt < 2.2; ++k) session.step(scene.input->frame(k, double(k) * dt));
+  const float pressed = session.haptics().fingers[int(Finger::Index)].newtons;
+  ASSERT_GT(pressed, 0.05f);
+  captureSnapshot(poked, *scene.world, &session, k, double(k) * dt);
+  captureConstraintForces(poked, *scene.world);
+  ASSERT_EQ(poked.constraintForce.size(), poked.positions.size());
+
+  const Vec3 tip = poked.fingertips[int(Finger::Index)];
+  const float reach = 3.0f * poked.fingertipRadius;
+  float near = 0.0f, nearAtRest = 0.0f, nearMax = 0.0f;
+  for (std::size_t i = 0; i < poked.positions.size(); ++i)
+    if ((poked.positions[i] - tip).norm() < reach) {
+      near += poked.constraintForce[i];
+      nearAtRest += rest.constraintForce[i];
+      nearMax = std::max(nearMax, poked.constraintForce[i]);
+    }
+  // 5 iterations x 8 substeps do not converge fully: half of it, at least.
+  EXPECT_GT(near - nearAtRest, 0.5f * pressed) << "at rest " << nearAtRest << " N, poked " << near << " N";
+  // The default range (three particles' weight) puts the pressed spot at full colour.
+  EXPECT_GT(nearMax, defaultColorRange(ColorMap::ConstraintForce, rest));
+  posed.pose(poked, ColorMap::ConstraintForce);
+  EXPECT_GT(*std::max_element(posed.values(0).begin(), posed.values(0).end()), 0.0f);
+  EXPECT_EQ(parseColorMap("force"), ColorMap::ConstraintForce);
 }
 
 // The mouse as the hand (render/mouse_hand.h) on the settled liver, stepped here as the viewer's

@@ -32,24 +32,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// The glove's thimbles as an output of the loop: each step's forces, sent without waiting.
-class GloveForces final : public HapticOutput {
- public:
-  explicit GloveForces(GloveLink& glove) : glove_(glove) {}
-  void send(const HapticSample& sample) override { glove_.publishForces(sample.force); }
-  void release() override { glove_.publishForces({}); }
-
- private:
-  GloveLink& glove_;
-};
-
 // A built scene running: its loop, the hand that drives it and what the window draws of it.
 // Members in dependency order: destroyed from the bottom up, the loop stops before its inputs go.
 struct Running {
   BuiltScene scene;
   LiveHandInput mouseInput;
   std::optional<GloveLink> glove;
-  std::optional<GloveForces> gloveForces;
   std::unique_ptr<SimulationLoop> loop;
   std::shared_ptr<SnapshotChannel> channel;
   Snapshot settled;  // the world before the first step: drawn until the first snapshot arrives
@@ -78,13 +66,13 @@ std::unique_ptr<Running> start(const SceneSpec& spec, const std::string& weart) 
   if (!weart.empty() && spec.hand.enabled) {
     const Vec3 point = r->scene.actions.empty() ? r->scene.bodies.front().top : r->scene.actions.front().target;
     r->glove.emplace(weart, r->scene.session.hand, point);
-    r->gloveForces.emplace(*r->glove);
     settings.input = &r->glove->input();
-    settings.outputs.push_back(&*r->gloveForces);
+    settings.outputs.push_back(&r->glove->output());
   } else {
     settings.input = &r->mouseInput;
   }
   captureSnapshot(r->settled, *r->scene.world, nullptr, 0, 0.0);
+  captureConstraintForces(r->settled, *r->scene.world);
   r->posed.pose(r->settled, ColorMap::None);
   r->loop = std::make_unique<SimulationLoop>(r->scene, settings);
   r->channel = r->loop->subscribe();
@@ -116,6 +104,7 @@ class Viewer {
     spec_ = loadSceneByName(options.scene);
     sceneName_ = spec_.name;
     rebuild();
+    render_.colorRange = defaultColorRange(options.colorMap, running_->settled);
   }
 
   int run();
@@ -169,6 +158,7 @@ void Viewer::rebuild() {
   glfwSetWindowTitle(window_, fmt::format("vrdeform view: {}", spec_.name).c_str());
   camera_.frame(running_->posed.bounds());
   running_->loop->setPaused(paused_);
+  running_->loop->setConstraintForces(render_.colorMap == ColorMap::ConstraintForce);
   for (History& h : force_) h = History();
   for (History& h : newtons_) h = History();
   lastStep_ = 0;
@@ -272,11 +262,16 @@ void Viewer::scenePanel() {
       "reframe");
 
   int map = int(render_.colorMap);
-  if (ImGui::Combo("colour", &map, "none\0strain\0volume change\0")) {
+  if (ImGui::Combo("colour", &map, "none\0strain\0volume change\0constraint force\0")) {
     render_.colorMap = ColorMap(map);
+    render_.colorRange = defaultColorRange(render_.colorMap, running_->settled);
+    running_->loop->setConstraintForces(render_.colorMap == ColorMap::ConstraintForce);
     colorMapChanged_ = true;
   }
-  ImGui::SliderFloat("range", &render_.colorRange, 0.001f, 0.5f, "%.3f", ImGuiSliderFlags_Logarithmic);
+  if (render_.colorMap == ColorMap::ConstraintForce)
+    ImGui::SliderFloat("range (N)", &render_.colorRange, 0.001f, 100.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
+  else
+    ImGui::SliderFloat("range", &render_.colorRange, 0.001f, 0.5f, "%.3f", ImGuiSliderFlags_Logarithmic);
   ImGui::Checkbox("fingertips", &render_.fingertips);
   ImGui::SameLine();
   ImGui::Checkbox("colliders", &render_.colliders);

@@ -12,6 +12,8 @@
 #include <system_error>
 #include <utility>
 
+#include "io/json_depth.h"
+
 namespace vrd::weart {
 namespace {
 
@@ -135,29 +137,6 @@ double wireDouble(float v) {
 }
 
 // --- Frames ----------------------------------------------------------------------------------------
-
-/// Nesting depth of a JSON text (brackets outside strings) is at most `maxDepth`.
-bool jsonDepthWithin(std::string_view s, int maxDepth) {
-  int depth = 0;
-  bool inString = false, escaped = false;
-  for (const char c : s) {
-    if (inString) {
-      if (escaped)
-        escaped = false;
-      else if (c == '\\')
-        escaped = true;
-      else if (c == '"')
-        inString = false;
-    } else if (c == '"') {
-      inString = true;
-    } else if (c == '{' || c == '[') {
-      if (++depth > maxDepth) return false;
-    } else if (c == '}' || c == ']') {
-      --depth;
-    }
-  }
-  return true;
-}
 
 /// The checks both parsers share: size, trimming, one trailing '~', bytes, JSON depth.
 struct Prepared {

@@ -16,14 +16,25 @@ std::string_view colorMapName(ColorMap map) {
       return "strain";
     case ColorMap::VolumeChange:
       return "volume";
+    case ColorMap::ConstraintForce:
+      return "force";
     case ColorMap::None:
       break;
   }
   return "none";
 }
 
+float defaultColorRange(ColorMap map, const Snapshot& settled) {
+  if (map != ColorMap::ConstraintForce) return 0.02f;
+  std::vector<float> load = settled.constraintForce;
+  if (load.empty()) return 1.0f;
+  std::nth_element(load.begin(), load.begin() + load.size() / 2, load.end());
+  const float median = load[load.size() / 2];
+  return median > 0.0f ? 3.0f * median : 1.0f;
+}
+
 std::optional<ColorMap> parseColorMap(std::string_view name) {
-  for (ColorMap m : {ColorMap::None, ColorMap::Strain, ColorMap::VolumeChange})
+  for (ColorMap m : {ColorMap::None, ColorMap::Strain, ColorMap::VolumeChange, ColorMap::ConstraintForce})
     if (colorMapName(m) == name) return m;
   return std::nullopt;
 }
@@ -71,7 +82,8 @@ PosedScene::PosedScene(const BuiltScene& scene) : meshes_(viewMeshes(scene)), co
   }
 }
 
-void PosedScene::particleValues(BodyRest& body, std::span<const Vec3> x, ColorMap map) const {
+void PosedScene::particleValues(BodyRest& body, std::span<const Vec3> x, std::span<const float> force,
+                                ColorMap map) const {
   std::vector<float>& out = body.particleValues;
   std::fill(out.begin(), out.end(), 0.0f);
   if (map == ColorMap::Strain) {
@@ -90,11 +102,14 @@ void PosedScene::particleValues(BodyRest& body, std::span<const Vec3> x, ColorMa
     }
     for (std::size_t i = 0; i < out.size(); ++i)
       if (body.tetCount[i] > 0.0f) out[i] /= body.tetCount[i];
+  } else if (map == ColorMap::ConstraintForce && !force.empty()) {
+    std::copy(force.begin(), force.end(), out.begin());
   }
 }
 
 void PosedScene::pose(const Snapshot& snapshot, ColorMap map) {
-  if (snapshot.positions.size() != particles_ || snapshot.bodyFirst.size() != bodies_.size())
+  if (snapshot.positions.size() != particles_ || snapshot.bodyFirst.size() != bodies_.size() ||
+      (!snapshot.constraintForce.empty() && snapshot.constraintForce.size() != particles_))
     throw Error(fmt::format("posed scene: a snapshot of {} particles in {} bodies, the scene has {} in {}",
                             snapshot.positions.size(), snapshot.bodyFirst.size(), particles_, bodies_.size()));
   bounds_.setEmpty();
@@ -113,7 +128,11 @@ void PosedScene::pose(const Snapshot& snapshot, ColorMap map) {
     for (const Tet& t : body.tets) volume += signedTetVolume(x[t[0]], x[t[1]], x[t[2]], x[t[3]]);
     body.volumeLoss = body.totalRestVolume > 0.0 ? (body.totalRestVolume - volume) / body.totalRestVolume : 0.0;
 
-    particleValues(body, x, map);
+    const std::span<const float> force =
+        snapshot.constraintForce.empty()
+            ? std::span<const float>()
+            : std::span(snapshot.constraintForce).subspan(snapshot.bodyFirst[m.body], x.size());
+    particleValues(body, x, force, map);
     const std::vector<float>& values = body.particleValues;
     if (map == ColorMap::None) {
       std::fill(p.values.begin(), p.values.end(), 0.0f);

@@ -1,30 +1,17 @@
 #include "vrdeform/scene/scene_library.h"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <cstdlib>
 
+#include "io/installed_data.h"
 #include "vrdeform/error.h"
 #include "vrdeform/scene/scene_file.h"
 
 namespace vrd {
-namespace {
 
 namespace fs = std::filesystem;
-
-// <prefix>/share/vrdeform/scenes for a program installed as <prefix>/bin/NAME.
-fs::path besideProgram() {
-  std::array<char, 4096> buffer{};
-  const ssize_t n = ::readlink("/proc/self/exe", buffer.data(), buffer.size() - 1);
-  if (n <= 0) return {};
-  return fs::path(std::string(buffer.data(), std::size_t(n))).parent_path().parent_path() / "share" / "vrdeform" /
-         "scenes";
-}
-
-}  // namespace
 
 fs::path sceneFolder() {
   if (const char* env = std::getenv("VRDEFORM_SCENES"); env && *env) {
@@ -32,10 +19,10 @@ fs::path sceneFolder() {
     return env;
   }
   std::error_code ec;
-  for (const fs::path& dir : {fs::path(VRDEFORM_SOURCE_SCENES), besideProgram()})
+  for (const fs::path& dir : {fs::path(VRDEFORM_SOURCE_SCENES), installedData("scenes")})
     if (!dir.empty() && fs::is_directory(dir, ec)) return dir;
   throw Error(fmt::format("the built-in scenes are missing (looked in {} and {}); set VRDEFORM_SCENES to their folder",
-                          VRDEFORM_SOURCE_SCENES, besideProgram().string()));
+                          VRDEFORM_SOURCE_SCENES, installedData("scenes").string()));
 }
 
 std::vector<SceneEntry> builtinScenes() {

@@ -215,6 +215,7 @@ void SimulationLoop::publish(std::uint64_t k, double stepWallMs) {
 
 void SimulationLoop::fill(Snapshot& s, std::uint64_t k, double stepWallMs) const {
   captureSnapshot(s, *scene_.world, session_ ? &*session_ : nullptr, k + 1, double(k + 1) * dt_, stepWallMs);
+  if (constraintForces_.load(std::memory_order_relaxed)) captureConstraintForces(s, *scene_.world);
 }
 
 void SimulationLoop::pace(Clock::time_point& origin, std::uint64_t& sinceOrigin) {

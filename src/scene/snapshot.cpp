@@ -13,6 +13,7 @@ void captureSnapshot(Snapshot& s, const World& world, const HapticSession* sessi
   for (std::size_t i = 0; i < x.size(); ++i) s.positions[i] = x[i].pos;
   s.bodyFirst.resize(world.bodyCount());
   for (std::size_t b = 0; b < s.bodyFirst.size(); ++b) s.bodyFirst[b] = world.body(BodyId(b)).firstParticle;
+  s.constraintForce.clear();
   s.fingerPresent = {};
   s.fingertips.fill(Vec3::Zero());
   s.fingertipRadius = 0.0f;
@@ -34,6 +35,15 @@ void captureSnapshot(Snapshot& s, const World& world, const HapticSession* sessi
   }
   s.times = session ? session->times() : world.lastStep().times;
   s.stepWallMs = stepWallMs;
+}
+
+void captureConstraintForces(Snapshot& s, const World& world) {
+  s.constraintForce.assign(world.particles().x.size(), 0.0f);
+  for (std::size_t b = 0; b < world.bodyCount(); ++b) {
+    const std::vector<Vec3> f = world.particleMaterialForces(BodyId(b));
+    const std::uint32_t first = world.body(BodyId(b)).firstParticle;
+    for (std::size_t i = 0; i < f.size(); ++i) s.constraintForce[first + i] = f[i].norm();
+  }
 }
 
 SnapshotChannel::SnapshotChannel(std::size_t particles, std::size_t bodies) {

@@ -525,7 +525,7 @@ double World::volumeLoss(BodyId id) const {
   return v0 > 0.0 ? (v0 - volume(id)) / v0 : 0.0;
 }
 
-std::vector<Vec3> World::particleConstraintForces(BodyId id) const {
+std::vector<Vec3> World::particleMaterialForces(BodyId id) const {
   const Body& b = bodies_.at(id);
   const BodyModel& m = *b.model;
   const float h = substepSize(), invH2 = 1.0f / (h * h);
@@ -558,7 +558,13 @@ std::vector<Vec3> World::particleConstraintForces(BodyId id) const {
         b.bendLambda[c]);
   }
   for (std::size_t i = 0; i < b.shapeMatchLambda.size(); ++i) f[i] += b.shapeMatchLambda[i] * invH2;
+  return f;
+}
 
+std::vector<Vec3> World::particleConstraintForces(BodyId id) const {
+  const Body& b = bodies_.at(id);
+  const float h = substepSize(), invH2 = 1.0f / (h * h);
+  std::vector<Vec3> f = particleMaterialForces(id);
   auto local = [&](Index particle) -> Vec3* {
     return particle >= b.firstParticle && particle < b.firstParticle + b.particleCount ? &f[particle - b.firstParticle]
                                                                                        : nullptr;

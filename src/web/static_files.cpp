@@ -1,29 +1,19 @@
 #include "vrdeform/web/static_files.h"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <cstdlib>
 #include <string>
 #include <vector>
 
+#include "io/installed_data.h"
 #include "vrdeform/error.h"
 
 namespace vrd {
 namespace {
 
 namespace fs = std::filesystem;
-
-// <prefix>/share/vrdeform/web for a program installed as <prefix>/bin/NAME.
-fs::path besideProgram() {
-  std::array<char, 4096> buffer{};
-  const ssize_t n = ::readlink("/proc/self/exe", buffer.data(), buffer.size() - 1);
-  if (n <= 0) return {};
-  return fs::path(std::string(buffer.data(), std::size_t(n))).parent_path().parent_path() / "share" / "vrdeform" /
-         "web";
-}
 
 bool hasPage(const fs::path& dir) {
   std::error_code ec;
@@ -82,10 +72,10 @@ fs::path webFolder() {
     if (!hasPage(env)) throw Error(fmt::format("VRDEFORM_WEB={}: no public/index.html there", env));
     return env;
   }
-  for (const fs::path& dir : {fs::path(VRDEFORM_SOURCE_WEB), besideProgram()})
+  for (const fs::path& dir : {fs::path(VRDEFORM_SOURCE_WEB), installedData("web")})
     if (hasPage(dir)) return dir;
   throw Error(fmt::format("the VR page is missing (looked in {} and {}); set VRDEFORM_WEB to its folder",
-                          VRDEFORM_SOURCE_WEB, besideProgram().string()));
+                          VRDEFORM_SOURCE_WEB, installedData("web").string()));
 }
 
 bool hasThreeJs(const fs::path& web) {

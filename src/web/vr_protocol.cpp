@@ -9,6 +9,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "io/json_depth.h"
 #include "vrdeform/devices/haptic_output.h"
 #include "vrdeform/error.h"
 
@@ -31,29 +32,6 @@ void putCommon(std::uint8_t* at, MessageKind kind) {
 }
 
 // --- Client messages ------------------------------------------------------------------------------
-
-// Nesting depth of a JSON text, strings skipped; stops counting past kMaxJsonDepth.
-bool tooDeep(std::string_view text) {
-  int depth = 0;
-  bool inString = false, escaped = false;
-  for (const char c : text) {
-    if (inString) {
-      if (escaped)
-        escaped = false;
-      else if (c == '\\')
-        escaped = true;
-      else if (c == '"')
-        inString = false;
-    } else if (c == '"') {
-      inString = true;
-    } else if (c == '[' || c == '{') {
-      if (++depth > kMaxJsonDepth) return true;
-    } else if (c == ']' || c == '}') {
-      --depth;
-    }
-  }
-  return false;
-}
 
 [[noreturn]] void bad(const std::string& what) { throw Error(what); }
 
@@ -128,7 +106,7 @@ XrInput input(const json& m) {
 }  // namespace
 
 ClientMessage parseClientMessage(std::string_view text) {
-  if (tooDeep(text)) bad(fmt::format("JSON nested deeper than {}", kMaxJsonDepth));
+  if (!jsonDepthWithin(text, kMaxJsonDepth)) bad(fmt::format("JSON nested deeper than {}", kMaxJsonDepth));
   json m = json::parse(text, nullptr, false);
   if (m.is_discarded()) bad("malformed JSON");
   if (!m.is_object()) bad("expected a JSON object");

@@ -8,7 +8,7 @@ vrdeform=$1 fake=$2 dir=$3 fingers=$4
 shift 4
 mkdir -p "$dir"
 printf '# t thumb index middle\n0 0 0 0\n1 0.9 0.9 0.9\n' > "$dir/close.script"
-"$fake" --port 0 --seconds 20 --script "$dir/close.script" --log "$dir/fake.log" > "$dir/fake.out" 2>&1 &
+"$fake" --port 0 --seconds 120 --script "$dir/close.script" --log "$dir/fake.log" > "$dir/fake.out" 2>&1 &
 pid=$!
 trap 'kill $pid 2>/dev/null || true' EXIT
 for _ in $(seq 50); do grep -q '^listening on' "$dir/fake.out" 2>/dev/null && break; sleep 0.1; done

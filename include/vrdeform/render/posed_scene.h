@@ -19,10 +19,17 @@ enum class ColorMap {
   None,          ///< each body its own colour
   Strain,        ///< mean stretch of the edges at each vertex, l / l0 - 1
   VolumeChange,  ///< mean relative volume change of the tets at each vertex, V / V0 - 1
+  /// |net force of the body's own constraints| on each particle (N), Snapshot::constraintForce:
+  /// at rest each particle's weight, more where a finger presses, the ground holds or a grasp pulls.
+  ConstraintForce,
 };
 
-/// "none", "strain", "volume".
+/// "none", "strain", "volume", "force".
 std::string_view colorMapName(ColorMap map);
+/// |value| a map draws at full colour by default: 2% strain or volume change; for force, three
+/// times the median of `settled`'s (the bodies at rest, constraint forces captured), about three
+/// particles' weight, so a poke, the ground's support or a grasp stands out.
+float defaultColorRange(ColorMap map, const Snapshot& settled);
 /// The inverse of colorMapName; nothing for another word.
 std::optional<ColorMap> parseColorMap(std::string_view name);
 
@@ -38,8 +45,9 @@ class PosedScene {
   /// Takes what it needs from `scene` (which must outlive it: the embeddings stay there).
   explicit PosedScene(const BuiltScene& scene);
 
-  /// Poses every mesh as `snapshot` has the bodies and computes `map`'s values. Throws vrd::Error
-  /// for a snapshot of another world (other particle or body counts).
+  /// Poses every mesh as `snapshot` has the bodies and computes `map`'s values (ConstraintForce
+  /// reads snapshot.constraintForce: zeros when the snapshot has none). Throws vrd::Error for a
+  /// snapshot of another world (other particle or body counts).
   void pose(const Snapshot& snapshot, ColorMap map);
 
   std::size_t meshCount() const { return meshes_.size(); }
@@ -76,7 +84,7 @@ class PosedScene {
     std::vector<float> values;
   };
 
-  void particleValues(BodyRest& body, std::span<const Vec3> x, ColorMap map) const;
+  void particleValues(BodyRest& body, std::span<const Vec3> x, std::span<const float> force, ColorMap map) const;
 
   std::vector<ViewMesh> meshes_;
   std::vector<BodyRest> bodies_;

@@ -107,6 +107,9 @@ class SimulationLoop {
   /// step, applied on the loop thread as subscribe() is picked up; the time step stays the loop's.
   /// Throws vrd::Error for invalid settings, at once on the calling thread.
   void setSolverSettings(const SolverSettings& settings);
+  /// Whether snapshots carry each particle's constraint force (Snapshot::constraintForce), from
+  /// the next step on; off by default, since it costs about one solver iteration a step.
+  void setConstraintForces(bool on) { constraintForces_.store(on, std::memory_order_relaxed); }
 
  private:
   using Clock = std::chrono::steady_clock;
@@ -140,6 +143,7 @@ class SimulationLoop {
   std::optional<SolverSettings> pendingSolver_;
   std::atomic<bool> solverChanged_{false};
   std::atomic<bool> paused_{false};
+  std::atomic<bool> constraintForces_{false};
   std::atomic<std::uint64_t> requestedSteps_{0};
 
   // Loop thread while running; the controlling thread after the join.

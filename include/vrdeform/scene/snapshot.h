@@ -22,6 +22,10 @@ struct Snapshot {
   double time = 0.0;                     ///< simulated time since the loop started (s), end of this step
   std::vector<Vec3> positions;           ///< every particle of the world, in world order
   std::vector<std::uint32_t> bodyFirst;  ///< first particle of each body (BodyId order)
+  /// |net force of the body's own constraints| on each particle (N, World::particleMaterialForces),
+  /// in world order: only when asked for (captureConstraintForces, SimulationLoop::setConstraintForces);
+  /// empty otherwise.
+  std::vector<float> constraintForce;
   /// Fingertip centres; zero where !fingerPresent.
   std::array<Vec3, kFingerCount> fingertips{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
   std::array<bool, kFingerCount> fingerPresent{};  ///< fingers the hand has; none without a hand
@@ -38,6 +42,10 @@ struct Snapshot {
 /// caller that steps the world itself (headless rendering). Reuses the vectors' capacity.
 void captureSnapshot(Snapshot& s, const World& world, const HapticSession* session, std::uint64_t step, double time,
                      double stepWallMs = 0.0);
+
+/// Fills `s.constraintForce` from `world`'s last substep (World::particleMaterialForces): about
+/// the cost of one solver iteration, so the loop does it only for a reader that shows it.
+void captureConstraintForces(Snapshot& s, const World& world);
 
 /// A triple buffer from the loop thread to one reader. The writer fills back() and publish()es it;
 /// the reader's update() swaps in the newest published slot. Each side owns one slot, the third

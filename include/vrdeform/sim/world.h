@@ -136,6 +136,10 @@ class World {
   /// triangle, the impulse applied: sum over the iterations of grad_i C dLambda, / h^2). At rest it
   /// balances the particle's weight and external force.
   std::vector<Vec3> particleConstraintForces(BodyId id) const;
+  /// The same from the body's own constraints only (distance, volume, strain, bending, shape
+  /// matching), without contacts and attachments: at rest it balances each particle's weight and
+  /// whatever touches it, so it shows where a finger presses and where the ground holds the body.
+  std::vector<Vec3> particleMaterialForces(BodyId id) const;
 
  private:
   void predict(float h);
