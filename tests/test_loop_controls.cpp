@@ -41,14 +41,27 @@ bool eventually(Pred pred) {
   return true;
 }
 
-TEST(LoopControls, PausedLoopStepsOnlyWhenAsked) {
+SimulationLoopSettings asFastAsItCan() {
+  SimulationLoopSettings s;
+  s.realTime = false;
+  return s;
+}
+
+// The liver's loop, started paused, with one reader.
+struct PausedLoop {
   BuiltScene scene = liver();
-  SimulationLoopSettings settings;
-  settings.realTime = false;
-  SimulationLoop loop(scene, settings);
-  loop.setPaused(true);
-  auto view = loop.subscribe();
-  loop.start();
+  SimulationLoop loop{scene, asFastAsItCan()};
+  std::shared_ptr<SnapshotChannel> view = loop.subscribe();
+  PausedLoop() {
+    loop.setPaused(true);
+    loop.start();
+  }
+};
+
+TEST(LoopControls, PausedLoopStepsOnlyWhenAsked) {
+  PausedLoop paused;
+  SimulationLoop& loop = paused.loop;
+  const auto& view = paused.view;
   std::this_thread::sleep_for(30ms);
   EXPECT_EQ(loop.steps(), 0u);  // paused from the start
   loop.requestSteps(3);
@@ -65,13 +78,9 @@ TEST(LoopControls, PausedLoopStepsOnlyWhenAsked) {
 }
 
 TEST(LoopControls, SnapshotsCarryConstraintForcesOnlyWhenAsked) {
-  BuiltScene scene = liver();
-  SimulationLoopSettings settings;
-  settings.realTime = false;
-  SimulationLoop loop(scene, settings);
-  loop.setPaused(true);
-  auto view = loop.subscribe();
-  loop.start();
+  PausedLoop paused;
+  SimulationLoop& loop = paused.loop;
+  const auto& view = paused.view;
   loop.requestSteps(1);
   ASSERT_TRUE(eventually([&] { return view->update() && view->front().step == 1; }));
   EXPECT_TRUE(view->front().constraintForce.empty());  // off by default: it costs an iteration
