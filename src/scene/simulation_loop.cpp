@@ -207,15 +207,20 @@ void SimulationLoop::step(std::uint64_t k) {
 }
 
 void SimulationLoop::publish(std::uint64_t k, double stepWallMs) {
+  if (channels_.empty()) return;
+  // The constraint forces cost about an iteration: computed once, copied to the other readers.
+  const bool forces = constraintForces_.load(std::memory_order_relaxed);
+  const Snapshot& first = channels_.front()->back();
   for (const std::shared_ptr<SnapshotChannel>& channel : channels_) {
-    fill(channel->back(), k, stepWallMs);
-    channel->publish();
+    Snapshot& s = channel->back();
+    captureSnapshot(s, *scene_.world, session_ ? &*session_ : nullptr, k + 1, double(k + 1) * dt_, stepWallMs);
+    if (!forces) continue;
+    if (&s == &first)
+      captureConstraintForces(s, *scene_.world);
+    else
+      s.constraintForce = first.constraintForce;
   }
-}
-
-void SimulationLoop::fill(Snapshot& s, std::uint64_t k, double stepWallMs) const {
-  captureSnapshot(s, *scene_.world, session_ ? &*session_ : nullptr, k + 1, double(k + 1) * dt_, stepWallMs);
-  if (constraintForces_.load(std::memory_order_relaxed)) captureConstraintForces(s, *scene_.world);
+  for (const std::shared_ptr<SnapshotChannel>& channel : channels_) channel->publish();
 }
 
 void SimulationLoop::pace(Clock::time_point& origin, std::uint64_t& sinceOrigin) {

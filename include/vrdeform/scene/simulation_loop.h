@@ -117,7 +117,6 @@ class SimulationLoop {
   void run();
   void step(std::uint64_t k);
   void publish(std::uint64_t k, double stepWallMs);
-  void fill(Snapshot& s, std::uint64_t k, double stepWallMs) const;
   void pickUpChannels();
   void pickUpSolverSettings();
   bool mayStep();  // not paused, or a requested step is left (taken)
