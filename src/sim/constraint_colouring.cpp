@@ -8,10 +8,60 @@ namespace {
 
 constexpr int kMaxColours = 64;  // one bit per colour in a particle's mask
 
+// Moves constraints out of colours whose last batch of `batch` lanes is partly empty into other
+// such colours where they fit, smallest partial batch first, so that fewer batches run with idle
+// lanes (a partial batch costs about as much as a full one). A colour whose whole partial batch
+// finds room elsewhere ends on a full batch, or empty.
+template <std::size_t N>
+void fillBatches(const std::vector<std::array<Index, N>>& constraints, std::size_t batch, std::vector<int>& colourOf,
+                 std::vector<std::size_t>& size, std::vector<std::uint64_t>& used) {
+  const int colours = int(size.size());
+  std::vector<std::vector<Index>> members(size.size());
+  for (std::size_t k = 0; k < constraints.size(); ++k)
+    if (colourOf[k] >= 0) members[colourOf[k]].push_back(Index(k));
+  const auto tail = [&](int c) { return size[c] % batch; };
+  std::vector<int> byTail(colours);
+  for (int c = 0; c < colours; ++c) byTail[c] = c;
+  std::stable_sort(byTail.begin(), byTail.end(), [&](int a, int b) { return tail(a) < tail(b); });
+  for (int from : byTail) {
+    if (tail(from) == 0) continue;
+    // Where each of `from`'s constraints could go: the fullest partial batch it fits in.
+    std::vector<std::pair<Index, int>> moves;
+    std::vector<std::size_t> room(size.size());
+    for (int c = 0; c < colours; ++c) room[c] = c == from || tail(c) == 0 ? 0 : batch - tail(c);
+    for (Index k : members[from]) {
+      if (moves.size() == tail(from)) break;
+      std::uint64_t taken = 0;
+      for (Index p : constraints[k]) taken |= used[p];
+      int best = -1;
+      for (int c = 0; c < colours; ++c)
+        if (room[c] > 0 && !(taken >> c & 1u) && (best < 0 || room[c] < room[best])) best = c;
+      if (best < 0) continue;
+      --room[best];
+      moves.push_back({k, best});
+      for (Index p : constraints[k]) used[p] |= std::uint64_t(1) << best;  // its later moves see it there
+    }
+    if (moves.size() < tail(from)) {  // not all of it: undo the reservations
+      for (const auto& [k, to] : moves)
+        for (Index p : constraints[k]) used[p] &= ~(std::uint64_t(1) << to);
+      continue;
+    }
+    for (const auto& [k, to] : moves) {
+      for (Index p : constraints[k]) used[p] &= ~(std::uint64_t(1) << from);
+      colourOf[k] = to;
+      --size[from];
+      ++size[to];
+      members[to].push_back(k);
+      std::erase(members[from], k);
+    }
+  }
+}
+
 }  // namespace
 
 template <std::size_t N>
-Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints, std::size_t minColourSize) {
+Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints, std::size_t minColourSize,
+                            std::size_t batch) {
   constexpr int kNone = -1;
   Index particles = 0;
   for (const auto& c : constraints)
@@ -34,6 +84,7 @@ Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints
     ++size[best];
     for (Index p : constraints[k]) used[p] |= std::uint64_t(1) << best;
   }
+  if (batch > 1) fillBatches(constraints, batch, colourOf, size, used);
 
   // Big colours first (largest first), the small ones and the uncoloured in the remainder.
   std::vector<int> colours;
@@ -76,8 +127,8 @@ bool coloursIndependent(const std::vector<std::array<Index, N>>& constraints,
   return true;
 }
 
-template Colouring colourConstraints<2>(const std::vector<std::array<Index, 2>>&, std::size_t);
-template Colouring colourConstraints<4>(const std::vector<std::array<Index, 4>>&, std::size_t);
+template Colouring colourConstraints<2>(const std::vector<std::array<Index, 2>>&, std::size_t, std::size_t);
+template Colouring colourConstraints<4>(const std::vector<std::array<Index, 4>>&, std::size_t, std::size_t);
 template bool coloursIndependent<2>(const std::vector<std::array<Index, 2>>&, const std::vector<std::uint32_t>&);
 template bool coloursIndependent<4>(const std::vector<std::array<Index, 4>>&, const std::vector<std::uint32_t>&);
 

@@ -6,6 +6,7 @@
 #include <immintrin.h>
 
 #include <cstring>
+#include <utility>
 
 #include "vrdeform/math/lanes.h"
 #include "vrdeform/sim/particles.h"
@@ -53,34 +54,56 @@ void split(T v, Lane4* part) {
 inline const float* floats(const Point* p) { return reinterpret_cast<const float*>(p); }
 inline float* floats(Point* p) { return reinterpret_cast<float*>(p); }
 
-/// The points idx[0..W) as lanes: coordinates x and inverse masses w.
-template <typename T>
-void loadPoints(const Point* pts, const Index* idx, V3<T>& x, T& w) {
-  Lane4 px[kGroups<T>], py[kGroups<T>], pz[kGroups<T>], pw[kGroups<T>];
-  for (std::size_t g = 0; g < kGroups<T>; ++g) {
-    const Index* i = idx + 4 * g;
-    __m128 r0 = _mm_load_ps(floats(pts + i[0])), r1 = _mm_load_ps(floats(pts + i[1]));
-    __m128 r2 = _mm_load_ps(floats(pts + i[2])), r3 = _mm_load_ps(floats(pts + i[3]));
-    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-    px[g] = r0, py[g] = r1, pz[g] = r2, pw[g] = r3;
+/// Lane 4g + k of the result is lane 4g + P[k] of a for P[k] < 4 and lane 4g + P[k] - 4 of b
+/// otherwise: the same pattern in every group g of four lanes (one unpack or shufps per register).
+template <int P0, int P1, int P2, int P3, typename T>
+T shuffleGroups(T a, T b) {
+  return [&]<std::size_t... L>(std::index_sequence<L...>) {
+    constexpr int pick[4] = {P0, P1, P2, P3};
+    return __builtin_shufflevector(a, b, int(L / 4 * 4 + pick[L % 4] % 4 + (pick[L % 4] < 4 ? 0 : kWidth<T>))...);
   }
-  x = {concat<T>(px), concat<T>(py), concat<T>(pz)};
-  w = concat<T>(pw);
+  (std::make_index_sequence<kWidth<T>>{});
 }
 
-/// Adds lane l of d to point idx[l]; the points must be distinct.
+/// _MM_TRANSPOSE4_PS in every group of four lanes at once: afterwards lane 4g + k of r[c] is what
+/// lane 4g + c of r[k] was.
 template <typename T>
-void addPoints(Point* pts, const Index* idx, const V3<T>& d) {
-  Lane4 px[kGroups<T>], py[kGroups<T>], pz[kGroups<T>];
-  split(d.x, px), split(d.y, py), split(d.z, pz);
-  for (std::size_t g = 0; g < kGroups<T>; ++g) {
-    __m128 r0 = px[g], r1 = py[g], r2 = pz[g], r3 = _mm_setzero_ps();  // w += 0
-    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-    const __m128 rows[4] = {r0, r1, r2, r3};
-    for (std::size_t l = 0; l < 4; ++l) {
-      float* p = floats(pts + idx[4 * g + l]);
-      _mm_store_ps(p, _mm_add_ps(_mm_load_ps(p), rows[l]));
-    }
+void transposeGroups(T (&r)[4]) {
+  const T t0 = shuffleGroups<0, 4, 1, 5>(r[0], r[1]), t1 = shuffleGroups<2, 6, 3, 7>(r[0], r[1]);
+  const T t2 = shuffleGroups<0, 4, 1, 5>(r[2], r[3]), t3 = shuffleGroups<2, 6, 3, 7>(r[2], r[3]);
+  r[0] = shuffleGroups<0, 1, 4, 5>(t0, t2), r[1] = shuffleGroups<2, 3, 6, 7>(t0, t2);
+  r[2] = shuffleGroups<0, 1, 4, 5>(t1, t3), r[3] = shuffleGroups<2, 3, 6, 7>(t1, t3);
+}
+
+/// The points idx[l * stride], l in [0, W), as lanes: coordinates x and inverse masses w. (The
+/// indices are read in place from an array of constraints: stride is the constraint's size in
+/// Indexes.) Register k holds in group g the point of lane 4g + k, and one transpose of all groups
+/// at once turns points into coordinates.
+template <typename T>
+void loadPoints(const Point* pts, const Index* idx, std::size_t stride, V3<T>& x, T& w) {
+  T r[4];
+  for (std::size_t k = 0; k < 4; ++k) {
+    Lane4 part[kGroups<T>];
+    for (std::size_t g = 0; g < kGroups<T>; ++g) part[g] = _mm_load_ps(floats(pts + idx[(4 * g + k) * stride]));
+    r[k] = concat<T>(part);
+  }
+  transposeGroups(r);
+  x = {r[0], r[1], r[2]};
+  w = r[3];
+}
+
+/// Writes lanes [0, count) of x and w to their points: loadPoints backwards. A batch's points are
+/// distinct and no other batch moves them meanwhile, so the new position x + dp is stored without
+/// reading the point again.
+template <typename T>
+void storePoints(Point* pts, const Index* idx, std::size_t stride, const V3<T>& x, T w, std::size_t count) {
+  T r[4] = {x.x, x.y, x.z, w};
+  transposeGroups(r);
+  for (std::size_t k = 0; k < 4; ++k) {
+    Lane4 part[kGroups<T>];
+    split(r[k], part);
+    for (std::size_t g = 0; g < kGroups<T>; ++g)
+      if (4 * g + k < count) _mm_store_ps(floats(pts + idx[(4 * g + k) * stride]), part[g]);
   }
 }
 

@@ -12,41 +12,35 @@
 namespace vrd::sweeps {
 
 /// Each function projects constraints [begin, end), which must be independent unless width is 1,
-/// `width` at a time, and returns where it stopped: the last (end - begin) % width are left for
-/// narrower lanes.
+/// `width` at a time; a last batch of fewer than `width` fills the rest of its lanes with padding.
 struct LaneSweeps {
   std::size_t width;
-  std::size_t (*distance)(const DistanceConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau,
-                          bool damped, const Range& r);
-  std::size_t (*volume)(const VolumeConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau,
-                        bool damped, const Range& r);
-  std::size_t (*strain)(const StrainConstraint* c, std::size_t begin, std::size_t end, StrainLambda* lambda,
-                        const ConstraintDamping& damping, bool damped, const Range& r);
+  void (*distance)(const DistanceConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau,
+                   bool damped, const Range& r);
+  void (*tets)(const TetArrays& t, std::size_t begin, std::size_t end, const ConstraintDamping& damping, bool damped,
+               const Range& r);
 };
 
 template <typename T>
 LaneSweeps makeLaneSweeps() {
-  constexpr std::size_t W = kWidth<T>;
   return {
-      W,
+      kWidth<T>,
       [](const DistanceConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau, bool damped,
          const Range& r) {
-        const std::size_t stop = begin + (end - begin) / W * W;
-        damped ? distance<T, true>(c, begin, stop, lambda, tau, r) : distance<T, false>(c, begin, stop, lambda, tau, r);
-        return stop;
+        damped ? distance<T, true>(c, begin, end, lambda, tau, r) : distance<T, false>(c, begin, end, lambda, tau, r);
       },
-      [](const VolumeConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau, bool damped,
+      [](const TetArrays& t, std::size_t begin, std::size_t end, const ConstraintDamping& damping, bool damped,
          const Range& r) {
-        const std::size_t stop = begin + (end - begin) / W * W;
-        damped ? volume<T, true>(c, begin, stop, lambda, tau, r) : volume<T, false>(c, begin, stop, lambda, tau, r);
-        return stop;
-      },
-      [](const StrainConstraint* c, std::size_t begin, std::size_t end, StrainLambda* lambda,
-         const ConstraintDamping& damping, bool damped, const Range& r) {
-        const std::size_t stop = begin + (end - begin) / W * W;
-        damped ? strain<T, true>(c, begin, stop, lambda, damping, r)
-               : strain<T, false>(c, begin, stop, lambda, damping, r);
-        return stop;
+        // One instance per combination, so that a body of volume constraints alone runs no strain code.
+        const auto run = [&]<bool Damped>() {
+          if (t.strain && t.volume)
+            tets<T, Damped, true, true>(t, begin, end, damping, r);
+          else if (t.strain)
+            tets<T, Damped, true, false>(t, begin, end, damping, r);
+          else
+            tets<T, Damped, false, true>(t, begin, end, damping, r);
+        };
+        damped ? run.template operator()<true>() : run.template operator()<false>();
       },
   };
 }
@@ -56,10 +50,22 @@ const LaneSweeps& sseSweeps();     ///< 4 lanes (sweeps_sse.cpp)
 const LaneSweeps& avx2Sweeps();    ///< 8 lanes (sweeps_avx2.cpp); only where cpuSupports(SimdLevel::Avx2)
 const LaneSweeps& avx512Sweeps();  ///< 16 lanes (sweeps_avx512.cpp); only where cpuSupports(SimdLevel::Avx512)
 
-/// The sweeps a colour runs through for `level`, widest first; always ends with scalarSweeps().
+/// The lane widths for `level`, widest first (SimdLevel::Off: one at a time). A colour runs in
+/// whole batches of the widest and ends with one partial batch of the narrowest that holds the rest.
 struct LanePlan {
   const LaneSweeps* widths[3] = {};
   std::size_t count = 0;
+
+  /// Projects [begin, end) of one colour; `project(sweeps, begin, end)` calls the array's sweep.
+  template <typename Project>
+  void run(std::size_t begin, std::size_t end, Project project) const {
+    const std::size_t whole = begin + (end - begin) / widths[0]->width * widths[0]->width;
+    if (begin < whole) project(*widths[0], begin, whole);
+    if (whole == end) return;
+    std::size_t w = count - 1;
+    while (widths[w]->width < end - whole) --w;
+    project(*widths[w], whole, end);
+  }
 };
 LanePlan lanePlan(SimdLevel level);
 

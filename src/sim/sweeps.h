@@ -1,9 +1,11 @@
 #pragma once
-// One Gauss-Seidel sweep per constraint type over a range of a body's constraints. Distance,
-// volume and strain are written once for every width: T = float (one constraint, Eigen vectors)
+// Gauss-Seidel sweeps over a range of a body's constraints. Distances and tets (strain, then
+// volume, on each tet) are written once for every width: T = float (one constraint, Eigen vectors)
 // or a lane type (lanes.h: kWidth<T> consecutive constraints of one colour at once, which is the
 // same sweep as taking them one by one). Bending and shape matching run one at a time.
 
+#include <algorithm>
+#include <cstddef>
 #include <type_traits>
 
 #include "lane_io.h"
@@ -14,48 +16,59 @@ namespace vrd::sweeps {
 template <typename T>
 using VecOf = std::conditional_t<std::is_same_v<T, float>, Vec3, V3<T>>;
 
-/// The N particles of one constraint (T = float) or of kWidth<T> constraints (lanes), with their
-/// inverse masses and, when damped, their motion since the start of the substep.
+/// The N particles of one constraint (T = float) or of kWidth<T> consecutive constraints (lanes),
+/// with their inverse masses and, when damped, their positions at the start of the substep. Lanes
+/// from `count` on are padding (see forBatches) and are never written back.
 template <typename T, std::size_t N, bool Damped>
 struct Gathered {
   using V = VecOf<T>;
-  V x[N], disp[N];
+  V x[N], xStart[N], disp[N];
   T w[N];
-  Index idx[N][kWidth<T>];
+  const Index* idx;    // particle a of lane l: idx[l * stride + a]
+  std::size_t stride;  // a constraint's size in Indexes
+  std::size_t count;
 
   template <typename C>
-  Gathered(const C* c, const Point* pred, const Point* start) {
+  Gathered(const C* c, std::size_t count, const Point* pred, const Point* start)
+      : idx(c->i), stride(sizeof(C) / sizeof(Index)), count(count) {
+    static_assert(offsetof(C, i) == 0 && sizeof(C) % sizeof(Index) == 0);
     for (std::size_t a = 0; a < N; ++a) {
-      for (std::size_t l = 0; l < kWidth<T>; ++l) idx[a][l] = c[l].i[a];
-      load(pred, idx[a], x[a], w[a]);
+      load(pred, idx + a, x[a], w[a]);
       if constexpr (Damped) {
-        V xs;
         T ws;
-        load(start, idx[a], xs, ws);
-        disp[a] = x[a] - xs;
+        load(start, idx + a, xStart[a], ws);
+        disp[a] = x[a] - xStart[a];
       }
     }
   }
+  /// Each particle's motion since the start of the substep (null when undamped).
   const V* displacement() const { return Damped ? disp : nullptr; }
 
-  void scatter(const V (&dp)[N], Point* pred) const {
-    for (std::size_t a = 0; a < N; ++a) add(pred, idx[a], dp[a]);
+  /// Applies a constraint's corrections here, for the next constraint on the same particles.
+  void move(const V (&dp)[N]) {
+    for (std::size_t a = 0; a < N; ++a) {
+      x[a] += dp[a];
+      if constexpr (Damped) disp[a] = x[a] - xStart[a];
+    }
+  }
+  /// Writes the positions back.
+  void store(Point* pred) const {
+    for (std::size_t a = 0; a < N; ++a) {
+      if constexpr (kWidth<T> == 1)
+        pred[idx[a]].pos = x[a];
+      else
+        storePoints(pred, idx + a, stride, x[a], w[a], count);
+    }
   }
 
  private:
-  static void load(const Point* pts, const Index* i, V& x, T& w) {
+  void load(const Point* pts, const Index* i, V& x, T& w) const {
     if constexpr (kWidth<T> == 1) {
-      x = pts[i[0]].pos;
-      w = pts[i[0]].w;
+      x = pts[*i].pos;
+      w = pts[*i].w;
     } else {
-      loadPoints(pts, i, x, w);
+      loadPoints(pts, i, stride, x, w);
     }
-  }
-  static void add(Point* pts, const Index* i, const V& d) {
-    if constexpr (kWidth<T> == 1)
-      pts[i[0]].pos += d;
-    else
-      addPoints(pts, i, d);
   }
 };
 
@@ -66,30 +79,55 @@ struct Range {
   float invH;          // 1/h
 };
 
-template <typename T, bool Damped>
-void distance(const DistanceConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau,
-              const Range& r) {
-  for (std::size_t i = begin; i < end; i += kWidth<T>) {
-    const Gathered<T, 2, Damped> g(c + i, r.pred, r.start);
-    const auto k =
-        XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &DistanceConstraint::compliance), splat<T>(tau), r.invH);
-    const auto out = solveDistance(g.x, g.w, fieldOf<T>(c + i, &DistanceConstraint::restLength),
-                                   loadLanes<T>(lambda + i), k, g.displacement());
-    addLanes<T>(lambda + i, out.dLambda);
-    g.scatter(out.dp, r.pred);
+/// W items of an array from `first`, the missing ones at its end copies of the first; a mutable
+/// array's real items are copied back by writeBack(). A null array stays null.
+template <std::size_t W, typename A>
+struct Padded {
+  std::remove_const_t<A> items[W];
+  A* source;
+
+  Padded(A* array, std::size_t first, std::size_t count) : source(array ? array + first : nullptr) {
+    if (source)
+      for (std::size_t l = 0; l < W; ++l) items[l] = source[l < count ? l : 0];
   }
+  A* data() { return source ? items : nullptr; }
+  void writeBack(std::size_t count) const {
+    if constexpr (!std::is_const_v<A>)
+      if (source) std::copy_n(items, count, source);
+  }
+};
+
+/// Calls batch(count, arrays + i...) for items [begin, end) of the parallel arrays (any may be
+/// null), kWidth<T> at a time (count = kWidth<T>); the last (end - begin) % kWidth<T> items go on
+/// copies padded with the first one's (count = how many are real), and the padding's results are
+/// dropped.
+template <typename T, typename Batch, typename... A>
+void forBatches(std::size_t begin, std::size_t end, Batch batch, A*... arrays) {
+  constexpr std::size_t W = kWidth<T>;
+  const auto at = [](auto* array, std::size_t i) { return array ? array + i : nullptr; };
+  std::size_t i = begin;
+  for (; i + W <= end; i += W) batch(W, at(arrays, i)...);
+  if (i == end) return;
+  const std::size_t count = end - i;
+  [&](Padded<W, A>... padded) {
+    batch(count, padded.data()...);
+    (padded.writeBack(count), ...);
+  }(Padded<W, A>(arrays, i, count)...);
 }
 
 template <typename T, bool Damped>
-void volume(const VolumeConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau, const Range& r) {
-  for (std::size_t i = begin; i < end; i += kWidth<T>) {
-    const Gathered<T, 4, Damped> g(c + i, r.pred, r.start);
-    const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &VolumeConstraint::compliance), splat<T>(tau), r.invH);
-    const auto out = solveVolume(g.x, g.w, fieldOf<T>(c + i, &VolumeConstraint::restVolume), loadLanes<T>(lambda + i),
-                                 k, g.displacement());
-    addLanes<T>(lambda + i, out.dLambda);
-    g.scatter(out.dp, r.pred);
-  }
+[[gnu::flatten]] void distance(const DistanceConstraint* constraints, std::size_t begin, std::size_t end,
+                               float* lambdas, float tau, const Range& r) {
+  const auto batch = [&](std::size_t count, const DistanceConstraint* c, float* lambda) {
+    Gathered<T, 2, Damped> g(c, count, r.pred, r.start);
+    const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &DistanceConstraint::compliance), splat<T>(tau), r.invH);
+    const auto out = solveDistance(g.x, g.w, fieldOf<T>(c, &DistanceConstraint::restLength), loadLanes<T>(lambda), k,
+                                   g.displacement());
+    addLanes<T>(lambda, out.dLambda);
+    g.move(out.dp);
+    g.store(r.pred);
+  };
+  forBatches<T>(begin, end, batch, constraints, lambdas);
 }
 
 // Strain weights a_k (strainWeights) of one tet or of kWidth<T> tets. For lanes, per group of
@@ -169,21 +207,51 @@ void addStrainLambda(StrainLambda* lambda, const StrainLambdaT<T>& delta) {
   }
 }
 
-template <typename T, bool Damped>
-void strain(const StrainConstraint* c, std::size_t begin, std::size_t end, StrainLambda* lambda,
-            const ConstraintDamping& damping, const Range& r) {
-  for (std::size_t i = begin; i < end; i += kWidth<T>) {
-    const Gathered<T, 4, Damped> g(c + i, r.pred, r.start);
-    VecOf<T> a[4];
-    strainWeightsOf<T>(c + i, a);
-    const auto stretch = XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &StrainConstraint::stretchCompliance),
-                                                    splat<T>(damping.strainStretch), r.invH);
-    const auto shear = XpbdCoefficientsT<T>::make(fieldOf<T>(c + i, &StrainConstraint::shearCompliance),
-                                                  splat<T>(damping.strainShear), r.invH);
-    const auto out = solveStrain(g.x, g.w, a, loadStrainLambda<T>(lambda + i), stretch, shear, g.displacement());
-    addStrainLambda<T>(lambda + i, out.dLambda);
-    g.scatter(out.dp, r.pred);
-  }
+/// A body's tet constraints: volume[j] and strain[j] belong to the same tet; either may be absent.
+struct TetArrays {
+  const StrainConstraint* strain;
+  const VolumeConstraint* volume;
+  StrainLambda* strainLambda;
+  float* volumeLambda;
+};
+
+// The tets, each (or kWidth<T> of one colour) gathered once: first its six strain constraints
+// (eqs. 29-34) if Strain, then its volume constraint (eqs. 16-23) if Volume, on the particles as
+// the strain left them: the Gauss-Seidel order "strain, volume" tet by tet. Volume last: S = F^T F
+// cannot tell a tet from its mirror image, so the signed volume gets the last word on orientation.
+template <typename T, bool Damped, bool Strain, bool Volume>
+[[gnu::flatten]] void tets(const TetArrays& t, std::size_t begin, std::size_t end, const ConstraintDamping& damping,
+                           const Range& r) {
+  const auto batch = [&](std::size_t count, const StrainConstraint* s, const VolumeConstraint* v,
+                         StrainLambda* strainLambda, float* volumeLambda) {
+    Gathered<T, 4, Damped> g = [&] {
+      if constexpr (Strain)
+        return Gathered<T, 4, Damped>(s, count, r.pred, r.start);
+      else
+        return Gathered<T, 4, Damped>(v, count, r.pred, r.start);
+    }();
+    if constexpr (Strain) {
+      VecOf<T> a[4];
+      strainWeightsOf<T>(s, a);
+      const auto stretch = XpbdCoefficientsT<T>::make(fieldOf<T>(s, &StrainConstraint::stretchCompliance),
+                                                      splat<T>(damping.strainStretch), r.invH);
+      const auto shear = XpbdCoefficientsT<T>::make(fieldOf<T>(s, &StrainConstraint::shearCompliance),
+                                                    splat<T>(damping.strainShear), r.invH);
+      const auto out = solveStrain(g.x, g.w, a, loadStrainLambda<T>(strainLambda), stretch, shear, g.displacement());
+      addStrainLambda<T>(strainLambda, out.dLambda);
+      g.move(out.dp);
+    }
+    if constexpr (Volume) {
+      const auto k =
+          XpbdCoefficientsT<T>::make(fieldOf<T>(v, &VolumeConstraint::compliance), splat<T>(damping.volume), r.invH);
+      const auto out = solveVolume(g.x, g.w, fieldOf<T>(v, &VolumeConstraint::restVolume), loadLanes<T>(volumeLambda),
+                                   k, g.displacement());
+      addLanes<T>(volumeLambda, out.dLambda);
+      g.move(out.dp);
+    }
+    g.store(r.pred);
+  };
+  forBatches<T>(begin, end, batch, t.strain, t.volume, t.strainLambda, t.volumeLambda);
 }
 
 // Bending, one at a time (not batched: bending is the lighter part of a cloth).
@@ -191,11 +259,12 @@ template <bool Damped>
 void bend(const std::vector<BendConstraint>& constraints, float* lambda, float tau, const Range& r) {
   for (std::size_t c = 0; c < constraints.size(); ++c) {
     const BendConstraint& con = constraints[c];
-    const Gathered<float, 4, Damped> g(&con, r.pred, r.start);
+    Gathered<float, 4, Damped> g(&con, 1, r.pred, r.start);
     const auto out = solveBend(g.x, g.w, con.restAngle, lambda[c], XpbdCoefficients::make(con.compliance, tau, r.invH),
                                g.displacement());
     lambda[c] += out.dLambda;
-    g.scatter(out.dp, r.pred);
+    g.move(out.dp);
+    g.store(r.pred);
   }
 }
 

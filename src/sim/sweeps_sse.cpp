@@ -15,18 +15,14 @@ const LaneSweeps& sseSweeps() {
 
 LanePlan lanePlan(SimdLevel level) {
   LanePlan plan;
-  switch (resolveSimd(level)) {
-    case SimdLevel::Avx512:
-      plan.widths[plan.count++] = &avx512Sweeps();
-      break;
-    case SimdLevel::Avx2:
-      plan.widths[plan.count++] = &avx2Sweeps();
-      break;
-    default:
-      break;
+  const SimdLevel widest = resolveSimd(level);
+  if (widest == SimdLevel::Off) {
+    plan.widths[plan.count++] = &scalarSweeps();
+    return plan;
   }
-  if (level != SimdLevel::Off) plan.widths[plan.count++] = &sseSweeps();
-  plan.widths[plan.count++] = &scalarSweeps();
+  if (widest == SimdLevel::Avx512) plan.widths[plan.count++] = &avx512Sweeps();
+  if (widest >= SimdLevel::Avx2) plan.widths[plan.count++] = &avx2Sweeps();
+  plan.widths[plan.count++] = &sseSweeps();
   return plan;
 }
 

@@ -327,19 +327,21 @@ void World::solveIterations(float h) {
 
 namespace {
 
-// One constraint array in colour order: each colour shared by the team and run through the lane
-// widths, widest first, then the remainder one at a time by the leader. `project(sweeps, begin,
-// end)` calls the array's sweep of that width and returns where it stopped.
+// One constraint array in colour order: each colour shared by the team and run through the lanes
+// (LanePlan::run), then the remainder one at a time by the leader. `project(sweeps, begin, end)`
+// calls the array's sweep of that width.
 template <typename Project>
 void sweepColours(const std::vector<std::uint32_t>& colours, std::size_t count, const sweeps::LanePlan& plan,
                   const SolverTeam& team, Project project) {
   constexpr std::size_t kAlign = 16;  // the widest lanes: every share but the last holds whole batches
   for (std::size_t k = 0; k + 1 < colours.size(); ++k) {
-    auto [begin, end] = team.share(colours[k], colours[k + 1], kAlign);
-    for (std::size_t w = 0; w < plan.count; ++w) begin = project(*plan.widths[w], begin, end);
+    const auto [begin, end] = team.share(colours[k], colours[k + 1], kAlign);
+    plan.run(begin, end, project);
     team.barrier();
   }
-  if (team.leader()) project(sweeps::scalarSweeps(), colours.empty() ? 0 : colours.back(), count);
+  const std::size_t remainder = colours.empty() ? 0 : colours.back();
+  if (remainder == count) return;  // the last colour's barrier was the last
+  if (team.leader()) project(sweeps::scalarSweeps(), remainder, count);
   team.barrier();
 }
 
@@ -362,25 +364,19 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
       const bool damped = tau.distance > 0.0f;
       sweepColours(m.distanceColours, m.distance.size(), plan, team,
                    [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
-                     return s.distance(m.distance.data(), begin, end, b.distanceLambda.data(), tau.distance, damped, r);
+                     s.distance(m.distance.data(), begin, end, b.distanceLambda.data(), tau.distance, damped, r);
                    });
     }
-    // Strain before volume: S = F^T F cannot tell a tet from its mirror image, so the signed
-    // volume constraint gets the last word on orientation.
-    if (!m.strain.empty()) {
-      StageTimer t(times, Stage::Strain, timed);
-      const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f;
-      sweepColours(m.tetColours, m.strain.size(), plan, team,
+    if (!m.strain.empty() || !m.volume.empty()) {
+      StageTimer t(times, Stage::Tets, timed);
+      const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f || tau.volume > 0.0f;
+      const sweeps::TetArrays tets{m.strain.empty() ? nullptr : m.strain.data(),
+                                   m.volume.empty() ? nullptr : m.volume.data(),
+                                   b.strainLambda.empty() ? nullptr : b.strainLambda.data(),
+                                   b.volumeLambda.empty() ? nullptr : b.volumeLambda.data()};
+      sweepColours(m.tetColours, std::max(m.strain.size(), m.volume.size()), plan, team,
                    [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
-                     return s.strain(m.strain.data(), begin, end, b.strainLambda.data(), tau, damped, r);
-                   });
-    }
-    if (!m.volume.empty()) {
-      StageTimer t(times, Stage::Volume, timed);
-      const bool damped = tau.volume > 0.0f;
-      sweepColours(m.tetColours, m.volume.size(), plan, team,
-                   [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
-                     return s.volume(m.volume.data(), begin, end, b.volumeLambda.data(), tau.volume, damped, r);
+                     s.tets(tets, begin, end, tau, damped, r);
                    });
     }
     if (!team.leader()) continue;  // the rest of the body runs one at a time

@@ -21,10 +21,13 @@ struct Colouring {
 
 /// Greedy colouring that balances the colours: each constraint, in input order, joins the
 /// smallest colour none of its particles is in yet, and opens a new colour (up to 64) only when
-/// there is none. Within a colour the input order is kept (neighbouring constraints stay near each
-/// other in memory). Colours with fewer than `minColourSize` constraints go to the remainder.
+/// there is none. Then, where they fit, constraints move out of colours whose size is not a
+/// multiple of `batch` (the widest SIMD lanes) into other such colours, so that fewer batches run
+/// with idle lanes. Within a colour the input order is kept (neighbouring constraints stay near
+/// each other in memory). Colours with fewer than `minColourSize` constraints go to the remainder.
 template <std::size_t N>
-Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints, std::size_t minColourSize);
+Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints, std::size_t minColourSize,
+                            std::size_t batch = 16);
 
 /// True when colourStart is non-decreasing within [0, constraints.size()] and no two constraints of
 /// one colour [colourStart[k], colourStart[k + 1]) share a particle.
