@@ -104,7 +104,7 @@ TEST(LatencyRecorder, EmptyRecorderHasNoFrames) {
   const LatencyRecorder r;
   EXPECT_EQ(r.frames(Phase::All), 0u);
   EXPECT_EQ(r.total(Phase::All).count, 0u);
-  EXPECT_TRUE(std::isnan(r.stage(Stage::Tets, Phase::Idle).mean));
+  EXPECT_TRUE(std::isnan(r.stage(Stage::Volume, Phase::Idle).mean));
 }
 
 TEST(LatencyRecorder, TableListsStagesThatTookTimeInBothBlocks) {

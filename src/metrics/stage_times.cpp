@@ -3,9 +3,9 @@
 namespace vrd {
 
 std::string_view stageName(Stage stage) {
-  static constexpr std::string_view kNames[kStageCount] = {"predict",   "detect",         "distance",   "tets",
-                                                           "bend",      "shape_matching", "attachment", "contact",
-                                                           "fingertip", "finalise",       "interact",   "force"};
+  static constexpr std::string_view kNames[kStageCount] = {
+      "predict",    "detect",  "distance",  "volume",   "strain",   "bend", "shape_matching",
+      "attachment", "contact", "fingertip", "finalise", "interact", "force"};
   return stage < Stage::Count ? kNames[std::size_t(stage)] : "?";
 }
 

@@ -330,15 +330,6 @@ void validateModel(const BodyModel& model) {
   checkColours("distance", model.distance, model.distanceColours);
   checkColours("volume", model.volume, model.tetColours);
   checkColours("strain", model.strain, model.tetColours);
-  // The solver projects strain[j] and volume[j] in one pass over their tet.
-  if (!model.strain.empty() && !model.volume.empty()) {
-    if (model.strain.size() != model.volume.size())
-      throw Error(fmt::format("body model has {} strain and {} volume constraints; with both, one of each per tet",
-                              model.strain.size(), model.volume.size()));
-    for (std::size_t c = 0; c < model.strain.size(); ++c)
-      if (!std::equal(std::begin(model.strain[c].i), std::end(model.strain[c].i), std::begin(model.volume[c].i)))
-        throw Error(fmt::format("strain constraint {} and volume constraint {} are on different tets", c, c));
-  }
   const ConstraintDamping& d = model.damping;
   for (float beta : {d.distance, d.volume, d.strainStretch, d.strainShear, d.bend, d.shapeMatching})
     if (!finiteNonNegative(beta)) throw Error(fmt::format("damping must be finite and >= 0, got {}", beta));

@@ -17,8 +17,10 @@ struct LaneSweeps {
   std::size_t width;
   void (*distance)(const DistanceConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau,
                    bool damped, const Range& r);
-  void (*tets)(const TetArrays& t, std::size_t begin, std::size_t end, const ConstraintDamping& damping, bool damped,
-               const Range& r);
+  void (*volume)(const VolumeConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau, bool damped,
+                 const Range& r);
+  void (*strain)(const StrainConstraint* c, std::size_t begin, std::size_t end, StrainLambda* lambda,
+                 const ConstraintDamping& damping, bool damped, const Range& r);
 };
 
 template <typename T>
@@ -29,18 +31,14 @@ LaneSweeps makeLaneSweeps() {
          const Range& r) {
         damped ? distance<T, true>(c, begin, end, lambda, tau, r) : distance<T, false>(c, begin, end, lambda, tau, r);
       },
-      [](const TetArrays& t, std::size_t begin, std::size_t end, const ConstraintDamping& damping, bool damped,
+      [](const VolumeConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau, bool damped,
          const Range& r) {
-        // One instance per combination, so that a body of volume constraints alone runs no strain code.
-        const auto run = [&]<bool Damped>() {
-          if (t.strain && t.volume)
-            tets<T, Damped, true, true>(t, begin, end, damping, r);
-          else if (t.strain)
-            tets<T, Damped, true, false>(t, begin, end, damping, r);
-          else
-            tets<T, Damped, false, true>(t, begin, end, damping, r);
-        };
-        damped ? run.template operator()<true>() : run.template operator()<false>();
+        damped ? volume<T, true>(c, begin, end, lambda, tau, r) : volume<T, false>(c, begin, end, lambda, tau, r);
+      },
+      [](const StrainConstraint* c, std::size_t begin, std::size_t end, StrainLambda* lambda,
+         const ConstraintDamping& damping, bool damped, const Range& r) {
+        damped ? strain<T, true>(c, begin, end, lambda, damping, r)
+               : strain<T, false>(c, begin, end, lambda, damping, r);
       },
   };
 }

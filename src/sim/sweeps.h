@@ -1,6 +1,6 @@
 #pragma once
-// Gauss-Seidel sweeps over a range of a body's constraints. Distances and tets (strain, then
-// volume, on each tet) are written once for every width: T = float (one constraint, Eigen vectors)
+// One Gauss-Seidel sweep per constraint type over a range of a body's constraints. Distance,
+// volume and strain are written once for every width: T = float (one constraint, Eigen vectors)
 // or a lane type (lanes.h: kWidth<T> consecutive constraints of one colour at once, which is the
 // same sweep as taking them one by one). Bending and shape matching run one at a time.
 
@@ -130,6 +130,21 @@ template <typename T, bool Damped>
   forBatches<T>(begin, end, batch, constraints, lambdas);
 }
 
+template <typename T, bool Damped>
+[[gnu::flatten]] void volume(const VolumeConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
+                             float tau, const Range& r) {
+  const auto batch = [&](std::size_t count, const VolumeConstraint* c, float* lambda) {
+    Gathered<T, 4, Damped> g(c, count, r.pred, r.start);
+    const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &VolumeConstraint::compliance), splat<T>(tau), r.invH);
+    const auto out =
+        solveVolume(g.x, g.w, fieldOf<T>(c, &VolumeConstraint::restVolume), loadLanes<T>(lambda), k, g.displacement());
+    addLanes<T>(lambda, out.dLambda);
+    g.move(out.dp);
+    g.store(r.pred);
+  };
+  forBatches<T>(begin, end, batch, constraints, lambdas);
+}
+
 // Strain weights a_k (strainWeights) of one tet or of kWidth<T> tets. For lanes, per group of
 // four: column i of each tet's D_rest^-1 is contiguous (Eigen is column-major) and holds
 // (a_1[i], a_2[i], a_3[i]), so one load per tet and a transpose give a_1[i], a_2[i] and a_3[i] for
@@ -207,51 +222,23 @@ void addStrainLambda(StrainLambda* lambda, const StrainLambdaT<T>& delta) {
   }
 }
 
-/// A body's tet constraints: volume[j] and strain[j] belong to the same tet; either may be absent.
-struct TetArrays {
-  const StrainConstraint* strain;
-  const VolumeConstraint* volume;
-  StrainLambda* strainLambda;
-  float* volumeLambda;
-};
-
-// The tets, each (or kWidth<T> of one colour) gathered once: first its six strain constraints
-// (eqs. 29-34) if Strain, then its volume constraint (eqs. 16-23) if Volume, on the particles as
-// the strain left them: the Gauss-Seidel order "strain, volume" tet by tet. Volume last: S = F^T F
-// cannot tell a tet from its mirror image, so the signed volume gets the last word on orientation.
-template <typename T, bool Damped, bool Strain, bool Volume>
-[[gnu::flatten]] void tets(const TetArrays& t, std::size_t begin, std::size_t end, const ConstraintDamping& damping,
-                           const Range& r) {
-  const auto batch = [&](std::size_t count, const StrainConstraint* s, const VolumeConstraint* v,
-                         StrainLambda* strainLambda, float* volumeLambda) {
-    Gathered<T, 4, Damped> g = [&] {
-      if constexpr (Strain)
-        return Gathered<T, 4, Damped>(s, count, r.pred, r.start);
-      else
-        return Gathered<T, 4, Damped>(v, count, r.pred, r.start);
-    }();
-    if constexpr (Strain) {
-      VecOf<T> a[4];
-      strainWeightsOf<T>(s, a);
-      const auto stretch = XpbdCoefficientsT<T>::make(fieldOf<T>(s, &StrainConstraint::stretchCompliance),
-                                                      splat<T>(damping.strainStretch), r.invH);
-      const auto shear = XpbdCoefficientsT<T>::make(fieldOf<T>(s, &StrainConstraint::shearCompliance),
-                                                    splat<T>(damping.strainShear), r.invH);
-      const auto out = solveStrain(g.x, g.w, a, loadStrainLambda<T>(strainLambda), stretch, shear, g.displacement());
-      addStrainLambda<T>(strainLambda, out.dLambda);
-      g.move(out.dp);
-    }
-    if constexpr (Volume) {
-      const auto k =
-          XpbdCoefficientsT<T>::make(fieldOf<T>(v, &VolumeConstraint::compliance), splat<T>(damping.volume), r.invH);
-      const auto out = solveVolume(g.x, g.w, fieldOf<T>(v, &VolumeConstraint::restVolume), loadLanes<T>(volumeLambda),
-                                   k, g.displacement());
-      addLanes<T>(volumeLambda, out.dLambda);
-      g.move(out.dp);
-    }
+template <typename T, bool Damped>
+[[gnu::flatten]] void strain(const StrainConstraint* constraints, std::size_t begin, std::size_t end,
+                             StrainLambda* lambdas, const ConstraintDamping& damping, const Range& r) {
+  const auto batch = [&](std::size_t count, const StrainConstraint* c, StrainLambda* lambda) {
+    Gathered<T, 4, Damped> g(c, count, r.pred, r.start);
+    VecOf<T> a[4];
+    strainWeightsOf<T>(c, a);
+    const auto stretch = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &StrainConstraint::stretchCompliance),
+                                                    splat<T>(damping.strainStretch), r.invH);
+    const auto shear = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &StrainConstraint::shearCompliance),
+                                                  splat<T>(damping.strainShear), r.invH);
+    const auto out = solveStrain(g.x, g.w, a, loadStrainLambda<T>(lambda), stretch, shear, g.displacement());
+    addStrainLambda<T>(lambda, out.dLambda);
+    g.move(out.dp);
     g.store(r.pred);
   };
-  forBatches<T>(begin, end, batch, t.strain, t.volume, t.strainLambda, t.volumeLambda);
+  forBatches<T>(begin, end, batch, constraints, lambdas);
 }
 
 // Bending, one at a time (not batched: bending is the lighter part of a cloth).

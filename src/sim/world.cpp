@@ -367,16 +367,22 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
                      s.distance(m.distance.data(), begin, end, b.distanceLambda.data(), tau.distance, damped, r);
                    });
     }
-    if (!m.strain.empty() || !m.volume.empty()) {
-      StageTimer t(times, Stage::Tets, timed);
-      const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f || tau.volume > 0.0f;
-      const sweeps::TetArrays tets{m.strain.empty() ? nullptr : m.strain.data(),
-                                   m.volume.empty() ? nullptr : m.volume.data(),
-                                   b.strainLambda.empty() ? nullptr : b.strainLambda.data(),
-                                   b.volumeLambda.empty() ? nullptr : b.volumeLambda.data()};
-      sweepColours(m.tetColours, std::max(m.strain.size(), m.volume.size()), plan, team,
+    // Strain before volume: S = F^T F cannot tell a tet from its mirror image, so the signed
+    // volume constraint gets the last word on orientation.
+    if (!m.strain.empty()) {
+      StageTimer t(times, Stage::Strain, timed);
+      const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f;
+      sweepColours(m.tetColours, m.strain.size(), plan, team,
                    [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
-                     s.tets(tets, begin, end, tau, damped, r);
+                     s.strain(m.strain.data(), begin, end, b.strainLambda.data(), tau, damped, r);
+                   });
+    }
+    if (!m.volume.empty()) {
+      StageTimer t(times, Stage::Volume, timed);
+      const bool damped = tau.volume > 0.0f;
+      sweepColours(m.tetColours, m.volume.size(), plan, team,
+                   [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
+                     s.volume(m.volume.data(), begin, end, b.volumeLambda.data(), tau.volume, damped, r);
                    });
     }
     if (!team.leader()) continue;  // the rest of the body runs one at a time

@@ -12,7 +12,8 @@ enum class Stage : std::uint8_t {
   Predict,        ///< forces, damping and predicted positions (Algorithm 1, lines 6-8)
   Detect,         ///< collider and fingertip contact detection (lines 10-11)
   Distance,       ///< stretch constraints
-  Tets,           ///< tet constraints: strain then volume, one pass per tet (paper Table 1's T_s + T_v)
+  Volume,         ///< tet volume constraints
+  Strain,         ///< tet strain constraints
   Bend,           ///< dihedral bending constraints
   ShapeMatching,  ///< global shape matching
   Attachment,     ///< attachments

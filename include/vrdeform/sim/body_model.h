@@ -85,9 +85,8 @@ void addDistanceConstraint(BodyModel& model, Index a, Index b, float compliance)
 ShapeMatchModel makeShapeMatchModel(const BodyModel& model, float compliance);
 
 /// Checks a hand-built or loaded model: finite positions, inverse masses finite and >= 0,
-/// constraint, tet, triangle and surface triangle indices in range, finite non-negative compliances,
-/// and strain[j] on the same particles as volume[j] when it has both (the solver projects them in
-/// one pass per tet). Throws vrd::Error naming the item.
+/// constraint, tet, triangle and surface triangle indices in range, finite non-negative compliances. Throws vrd::Error
+/// naming the item.
 void validateModel(const BodyModel& model);
 
 }  // namespace vrd
