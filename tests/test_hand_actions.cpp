@@ -76,6 +76,30 @@ TEST(HandActions, GraspClosesOnTheTargetLiftsAndLetsGo) {
   EXPECT_TRUE(input.finished(0, 10.01));
 }
 
+TEST(HandActions, EachActionAimsOnceAsItStarts) {
+  // Given out of order: the aim is asked by the index given, once, at the action's start.
+  std::vector<std::size_t> asked;
+  const Vec3 moved(0.15f, 0.18f, 0.3f);
+  HandActionsInput input({grasp(), poke()}, kRadius, [&](std::size_t index) {
+    asked.push_back(index);
+    return index == 0 ? Vec3(Vec3::Constant(std::numeric_limits<float>::quiet_NaN())) : moved;
+  });
+  input.frame(0, 0.5);  // parked above the poke: nothing asked yet
+  EXPECT_TRUE(asked.empty());
+  HandAction aimed = poke();
+  aimed.target = moved;
+  for (double t : {1.0, 2.0, 3.5}) {
+    const Vec3 tip = input.frame(0, t).fingertips[int(Finger::Index)];
+    EXPECT_FLOAT_EQ(tip.x(), moved.x());
+    EXPECT_FLOAT_EQ(tip.z(), moved.z());
+  }
+  EXPECT_NEAR(depthOf(input.frame(0, 3.5), Finger::Index, aimed), aimed.depth, 1e-6f);
+  // The grasp's aim is not finite: it keeps its planned target.
+  const HandFrame closing = input.frame(0, 7.0);
+  EXPECT_FLOAT_EQ(0.5f * (closing.fingertips[0].x() + closing.fingertips[1].x()), grasp().target.x());
+  EXPECT_EQ(asked, (std::vector<std::size_t>{1, 0}));
+}
+
 TEST(HandActions, RejectsOverlapsThumbGraspsAndBadValues) {
   HandAction late = poke();
   late.start = 4.0;  // the first ends at 5

@@ -79,13 +79,17 @@ HandFrame actionFrame(const HandAction& a, float r, double t) {
 
 }  // namespace
 
-HandActionsInput::HandActionsInput(std::vector<HandAction> actions, float fingertipRadius)
-    : actions_(std::move(actions)), radius_(fingertipRadius) {
+HandActionsInput::HandActionsInput(std::vector<HandAction> actions, float fingertipRadius, Aim aim)
+    : radius_(fingertipRadius), aim_(std::move(aim)) {
   if (!(std::isfinite(radius_) && radius_ > 0.0f)) throw Error("hand actions: the fingertip radius must be positive");
-  if (actions_.empty()) throw Error("hand actions: none given");
-  for (std::size_t i = 0; i < actions_.size(); ++i) check(actions_[i], i);
-  std::stable_sort(actions_.begin(), actions_.end(),
-                   [](const HandAction& a, const HandAction& b) { return a.start < b.start; });
+  if (actions.empty()) throw Error("hand actions: none given");
+  for (std::size_t i = 0; i < actions.size(); ++i) check(actions[i], i);
+  given_.resize(actions.size());
+  for (std::size_t i = 0; i < given_.size(); ++i) given_[i] = i;
+  std::stable_sort(given_.begin(), given_.end(),
+                   [&](std::size_t a, std::size_t b) { return actions[a].start < actions[b].start; });
+  for (std::size_t i : given_) actions_.push_back(actions[i]);
+  aimed_.assign(actions_.size(), false);
   for (std::size_t i = 1; i < actions_.size(); ++i)
     if (actions_[i].start < actions_[i - 1].end())
       throw Error(fmt::format("hand actions: an action starting at {:g} s overlaps one that ends at {:g} s",
@@ -95,9 +99,14 @@ HandActionsInput::HandActionsInput(std::vector<HandAction> actions, float finger
 HandFrame HandActionsInput::frame(std::uint64_t, double t) {
   // The action under way, else the next one (its fingertips wait parked above it), else the last.
   const auto next = std::find_if(actions_.begin(), actions_.end(), [t](const HandAction& a) { return t < a.end(); });
-  const HandAction& a = next == actions_.end() ? actions_.back() : *next;
-  if (t >= a.start && t < a.end()) return actionFrame(a, radius_, t);
-  return parked(a.target);
+  const std::size_t i = next == actions_.end() ? actions_.size() - 1 : std::size_t(next - actions_.begin());
+  HandAction& a = actions_[i];
+  if (!(t >= a.start && t < a.end())) return parked(a.target);
+  if (aim_ && !aimed_[i]) {
+    aimed_[i] = true;
+    if (const Vec3 target = aim_(given_[i]); isFinite(target)) a.target = target;
+  }
+  return actionFrame(a, radius_, t);
 }
 
 bool HandActionsInput::finished(std::uint64_t, double t) const { return !(t <= actions_.back().end()); }

@@ -211,20 +211,27 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log) {
   scene.session.haptics = spec.haptics.settings;
   if (!hand.enabled) return scene;
 
-  for (const ActionSpec& a : hand.actions) {
-    const SceneBody& target = a.body.empty() ? scene.bodies.front() : scene.body(a.body);
-    HandAction action = a.action;
-    action.target = target.top;
-    if (a.offset.x() != 0.0f || a.offset.z() != 0.0f)
-      action.target = surfaceBelow(world, target.id, target.top + Vec3(a.offset.x(), 0.0f, a.offset.z()),
-                                   2.0f * hand.rig.geometry.fingertipRadius);
+  const float radius = hand.rig.geometry.fingertipRadius;
+  // Each action aims at its body's top, moved by its offset: where the body settled when planned,
+  // and again where the body is when the action starts (a poke may have rolled it away).
+  std::vector<std::pair<BodyId, Vec3>> aims;
+  for (const ActionSpec& a : hand.actions)
+    aims.emplace_back((a.body.empty() ? scene.bodies.front() : scene.body(a.body)).id, a.offset);
+  const auto aim = [&world, aims, radius](std::size_t index) {
+    const auto [body, offset] = aims[index];
+    const Vec3 top = topPoint(world, body);
+    if (offset.x() == 0.0f && offset.z() == 0.0f) return top;
+    return surfaceBelow(world, body, top + Vec3(offset.x(), 0.0f, offset.z()), 2.0f * radius);
+  };
+  for (std::size_t i = 0; i < hand.actions.size(); ++i) {
+    HandAction action = hand.actions[i].action;
+    action.target = aim(i);
     scene.actions.push_back(action);
   }
-  const float radius = hand.rig.geometry.fingertipRadius;
   if (!hand.script.empty())
     scene.input = std::make_unique<HandScriptInput>(HandScript::load(hand.script));
   else if (!scene.actions.empty())
-    scene.input = std::make_unique<HandActionsInput>(scene.actions, radius);
+    scene.input = std::make_unique<HandActionsInput>(scene.actions, radius, aim);
 
   if (spec.haptics.calibrate) {
     // Calibrate where the first action goes (else on the first body's top), as the hand will touch.

@@ -1,8 +1,9 @@
 #pragma once
 // Scripted pokes and pinch grasps aimed at points of a body, as fingertip centres given directly
-// (HandFrame::direct). Scenes aim them at a body's top after it settles (scene/scene_spec.h); the
-// `touch` command's standard poke is one of them.
+// (HandFrame::direct). Scenes aim each at a body's top as the action starts (scene/scene_spec.h);
+// the `touch` command's standard poke is one of them.
 
+#include <functional>
 #include <vector>
 
 #include "vrdeform/interact/hand_input.h"
@@ -34,8 +35,12 @@ struct HandAction {
 /// 1 m above the current (or next, or last) target, spaced 5 cm apart.
 class HandActionsInput final : public HandInput {
  public:
+  /// Where action `index` (of those given) aims, asked once as it starts: a body poked may have
+  /// moved since the actions were planned. Its answer replaces the target unless it is not finite.
+  using Aim = std::function<Vec3(std::size_t index)>;
+
   /// Throws vrd::Error for non-finite or negative values, overlapping actions or a grasp by the thumb.
-  HandActionsInput(std::vector<HandAction> actions, float fingertipRadius);
+  HandActionsInput(std::vector<HandAction> actions, float fingertipRadius, Aim aim = {});
 
   HandFrame frame(std::uint64_t step, double time) override;
   /// After the last action has ended (or for a NaN time).
@@ -44,7 +49,10 @@ class HandActionsInput final : public HandInput {
 
  private:
   std::vector<HandAction> actions_;  // sorted by start
+  std::vector<std::size_t> given_;   // each one's index among those given
+  std::vector<bool> aimed_;
   float radius_;
+  Aim aim_;
 };
 
 }  // namespace vrd

@@ -1,7 +1,7 @@
 #pragma once
 // Turns a SceneSpec into a running world: meshes read (surfaces tetrahedralised), placed and made
 // into bodies, colliders, wind and pins, the bodies settled under gravity, the haptic scales
-// calibrated, and the hand's input (actions or a script) aimed at where the bodies came to rest.
+// calibrated, and the hand's input (actions or a script), whose actions aim at their bodies' tops.
 
 #include <cstdint>
 #include <functional>

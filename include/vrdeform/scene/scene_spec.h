@@ -44,7 +44,7 @@ struct BodySpec {
 };
 
 /// One scripted action of the hand (hand_actions.h) on a body, timed from the end of the settling
-/// phase and aimed at where that body came to rest.
+/// phase and aimed at that body's top where it is when the action starts.
 struct ActionSpec {
   std::string body;  ///< empty: the first body
   /// Moves the target from the body's top along x and z (m), down to the highest particle within two
