@@ -43,6 +43,31 @@ TEST(Colouring, IsAPermutationOfBalancedIndependentColours) {
   EXPECT_FALSE(coloursIndependent(mesh.tets, {0, 8}));
 }
 
+TEST(Colouring, PartsShareNoParticleAndLeaveAThinSeam) {
+  const TetMesh mesh = makeBoxTets(Vec3::Zero(), Vec3(1.0f, 2.0f, 1.0f), 12, 12, 12);  // 10,368 tets
+  // The grid's vertices run x fastest and z slowest: only a cut across z keeps neighbours in memory
+  // in one slab (y is the longest side), the first half of the vertices in slab 0.
+  const std::vector<std::uint8_t> slab = slabsOf(mesh.vertices, 2);
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) ASSERT_EQ(slab[v], 2 * v / mesh.vertices.size()) << v;
+  const Colouring c = colourConstraints(mesh.tets, 8, 16, slab);
+  std::vector<Tet> ordered;
+  for (Index k : c.order) ordered.push_back(mesh.tets[k]);
+  ASSERT_EQ(c.partColours.size(), 3u);
+  EXPECT_TRUE(coloursIndependent(ordered, c.colourStart, c.partColours));
+  const auto tetsIn = [&](std::size_t from, std::size_t to) { return c.colourStart[to] - c.colourStart[from]; };
+  const std::size_t colours = c.colourStart.size() - 1, seam = tetsIn(c.partColours[2], colours);
+  for (std::size_t part = 0; part < 2; ++part)
+    for (std::uint32_t k = c.colourStart[c.partColours[part]]; k < c.colourStart[c.partColours[part + 1]]; ++k)
+      for (Index v : ordered[k]) ASSERT_EQ(slab[v], part);
+  // The seam: the cells next to the cut, which runs through the middle layer of vertices.
+  EXPECT_GE(seam, mesh.tets.size() / 12);
+  EXPECT_LE(seam, 2 * mesh.tets.size() / 12) << seam;
+  EXPECT_NEAR(double(tetsIn(0, c.partColours[1])), double(tetsIn(c.partColours[1], c.partColours[2])),
+              0.2 * double(mesh.tets.size()));
+  // The checker is not vacuous: a part's colour moved to the other part shares particles.
+  EXPECT_FALSE(coloursIndependent(ordered, c.colourStart, {0, c.partColours[1] + 1, c.partColours[2]}));
+}
+
 TEST(Colouring, ModelWithDependentColourIsRejected) {
   auto model = std::make_shared<BodyModel>(*makeSoftBody(makeBoxTets(Vec3::Zero(), Vec3::Ones(), 6, 6, 6), Material{}));
   ASSERT_GE(model->tetColours.size(), 2u);
@@ -190,18 +215,24 @@ TEST(Lanes, EveryWidthAgreesWithTheReferenceLoops) {
   }
 }
 
-// Threads share each colour; constraints of a colour touch disjoint particles, so the result is
-// bit for bit the one-thread result.
+// Two threads sweep the body's two parts at once, three share each colour; either way constraints
+// run at once only when they touch disjoint particles, so the result is bit for bit the one-thread
+// result.
 TEST(Lanes, ThreadsGiveTheOneThreadResultExactly) {
 #if defined(__SANITIZE_THREAD__)
   GTEST_SKIP() << "libgomp is not built for ThreadSanitizer; its barriers would be reported as races";
 #endif
-  const auto model = dampedBlock(8, {true, true, true, true});
+  const auto model = dampedBlock(10, {true, true, true, true});  // 6,000 tets: cut in two parts
+  ASSERT_EQ(model->tetParts.size(), 3u);
+  ASSERT_EQ(model->distanceParts.size(), 3u);
   SolverSettings s;
   const std::vector<Vec3> one = sagBlock(model, s, 5);
-  s.threads = 2;  // (on a busy machine each colour's barrier may wait for a descheduled thread: few steps)
-  const std::vector<Vec3> two = sagBlock(model, s, 5);
-  for (Index i = 0; i < model->particleCount(); ++i) ASSERT_EQ(two[i], one[i]) << "particle " << i;
+  for (int threads : {2, 3}) {
+    s.threads = threads;  // (on a busy machine a barrier may wait for a descheduled thread: few steps)
+    const std::vector<Vec3> many = sagBlock(model, s, 5);
+    for (Index i = 0; i < model->particleCount(); ++i)
+      ASSERT_EQ(many[i], one[i]) << threads << " threads, particle " << i;
+  }
 }
 
 // The coloured order is another Gauss-Seidel order: it settles to the same static equilibrium as

@@ -57,11 +57,9 @@ void fillBatches(const std::vector<std::array<Index, N>>& constraints, std::size
   }
 }
 
-}  // namespace
-
 template <std::size_t N>
-Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints, std::size_t minColourSize,
-                            std::size_t batch) {
+Colouring colourAll(const std::vector<std::array<Index, N>>& constraints, std::size_t minColourSize,
+                    std::size_t batch) {
   constexpr int kNone = -1;
   Index particles = 0;
   for (const auto& c : constraints)
@@ -107,15 +105,76 @@ Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints
   return out;
 }
 
+}  // namespace
+
+template <std::size_t N>
+Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints, std::size_t minColourSize,
+                            std::size_t batch, const std::vector<std::uint8_t>& partOf) {
+  if (partOf.empty()) return colourAll(constraints, minColourSize, batch);
+  // Group g < parts: the constraints wholly in part g; group `parts`: the seam.
+  const std::size_t parts = std::size_t(*std::max_element(partOf.begin(), partOf.end())) + 1;
+  std::vector<std::vector<Index>> members(parts + 1);
+  for (std::size_t k = 0; k < constraints.size(); ++k) {
+    std::size_t group = partOf.at(constraints[k][0]);
+    for (Index p : constraints[k])
+      if (partOf.at(p) != group) group = parts;
+    members[group].push_back(Index(k));
+  }
+  Colouring out;
+  std::vector<Index> remainder;
+  for (const std::vector<Index>& group : members) {
+    out.partColours.push_back(std::uint32_t(out.colourStart.size()));
+    std::vector<std::array<Index, N>> own;
+    for (Index k : group) own.push_back(constraints[k]);
+    const Colouring c = colourAll(own, minColourSize, batch);
+    const std::size_t base = out.order.size(), coloured = c.colourStart.empty() ? 0 : c.colourStart.back();
+    for (std::size_t k = 0; k + 1 < c.colourStart.size(); ++k)
+      out.colourStart.push_back(std::uint32_t(base + c.colourStart[k]));
+    for (std::size_t i = 0; i < coloured; ++i) out.order.push_back(group[c.order[i]]);
+    for (std::size_t i = coloured; i < c.order.size(); ++i) remainder.push_back(group[c.order[i]]);
+  }
+  if (out.colourStart.empty())
+    out.partColours.clear();  // no colour at all
+  else
+    out.colourStart.push_back(std::uint32_t(out.order.size()));
+  out.order.insert(out.order.end(), remainder.begin(), remainder.end());
+  return out;
+}
+
+std::vector<std::uint8_t> slabsOf(const std::vector<Vec3>& points, int parts) {
+  const auto cut = [&](int axis) {
+    std::vector<Index> byHeight(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) byHeight[i] = Index(i);
+    std::stable_sort(byHeight.begin(), byHeight.end(),
+                     [&](Index a, Index b) { return points[a][axis] < points[b][axis]; });
+    std::vector<std::uint8_t> slab(points.size());
+    for (std::size_t r = 0; r < byHeight.size(); ++r)
+      slab[byHeight[r]] = std::uint8_t(r * std::size_t(parts) / points.size());
+    return slab;
+  };
+  // Neighbours in memory in different slabs share cache lines that both threads write: cut across
+  // the axis along which the points' order changes slab least often (a grid's slowest axis).
+  const auto changes = [](const std::vector<std::uint8_t>& slab) {
+    std::size_t n = 0;
+    for (std::size_t i = 1; i < slab.size(); ++i) n += slab[i] != slab[i - 1];
+    return n;
+  };
+  std::vector<std::uint8_t> best = cut(0);
+  for (int axis = 1; axis < 3; ++axis)
+    if (std::vector<std::uint8_t> slab = cut(axis); changes(slab) < changes(best)) best = std::move(slab);
+  return best;
+}
+
 template <std::size_t N>
 bool coloursIndependent(const std::vector<std::array<Index, N>>& constraints,
-                        const std::vector<std::uint32_t>& colourStart) {
-  if (colourStart.empty()) return true;
+                        const std::vector<std::uint32_t>& colourStart, const std::vector<std::uint32_t>& partColours) {
+  if (colourStart.empty()) return partColours.empty();
   if (colourStart.back() > constraints.size()) return false;
   Index particles = 0;
   for (const auto& c : constraints)
     for (Index p : c) particles = std::max(particles, p + 1);
-  std::vector<std::uint32_t> seenIn(particles, std::numeric_limits<std::uint32_t>::max());
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> seenIn(particles, kNone);
   for (std::size_t k = 0; k + 1 < colourStart.size(); ++k) {
     if (colourStart[k] > colourStart[k + 1]) return false;
     for (std::uint32_t c = colourStart[k]; c < colourStart[k + 1]; ++c) {
@@ -124,12 +183,29 @@ bool coloursIndependent(const std::vector<std::array<Index, N>>& constraints,
       for (Index p : constraints[c]) seenIn[p] = std::uint32_t(k);
     }
   }
+  if (partColours.empty()) return true;
+  // Parts: non-decreasing colour ranges, the seam's last; no particle in two parts.
+  const std::size_t colours = colourStart.size() - 1;
+  if (partColours.front() != 0 || partColours.back() > colours) return false;
+  std::vector<std::uint32_t> partOf(particles, kNone);
+  for (std::size_t part = 0; part + 1 < partColours.size(); ++part) {
+    if (partColours[part] > partColours[part + 1]) return false;
+    for (std::uint32_t c = colourStart[partColours[part]]; c < colourStart[partColours[part + 1]]; ++c)
+      for (Index p : constraints[c]) {
+        if (partOf[p] != kNone && partOf[p] != part) return false;
+        partOf[p] = std::uint32_t(part);
+      }
+  }
   return true;
 }
 
-template Colouring colourConstraints<2>(const std::vector<std::array<Index, 2>>&, std::size_t, std::size_t);
-template Colouring colourConstraints<4>(const std::vector<std::array<Index, 4>>&, std::size_t, std::size_t);
-template bool coloursIndependent<2>(const std::vector<std::array<Index, 2>>&, const std::vector<std::uint32_t>&);
-template bool coloursIndependent<4>(const std::vector<std::array<Index, 4>>&, const std::vector<std::uint32_t>&);
+template Colouring colourConstraints<2>(const std::vector<std::array<Index, 2>>&, std::size_t, std::size_t,
+                                        const std::vector<std::uint8_t>&);
+template Colouring colourConstraints<4>(const std::vector<std::array<Index, 4>>&, std::size_t, std::size_t,
+                                        const std::vector<std::uint8_t>&);
+template bool coloursIndependent<2>(const std::vector<std::array<Index, 2>>&, const std::vector<std::uint32_t>&,
+                                    const std::vector<std::uint32_t>&);
+template bool coloursIndependent<4>(const std::vector<std::array<Index, 4>>&, const std::vector<std::uint32_t>&,
+                                    const std::vector<std::uint32_t>&);
 
 }  // namespace vrd
