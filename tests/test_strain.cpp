@@ -93,7 +93,10 @@ TEST(Strain, PureStretchProducesOnlyStretchMultipliers) {
   const HomogeneousBlock block(Vec3(1.02f, 1.0f, 1.0f).asDiagonal());
   // S = diag(1.02^2, 1, 1): only C_00 = 0.0404 is violated.
   const float expected = (1.02f * 1.02f - 1.0f) / block.alphaTilde();
-  for (const StrainLambda& l : block.world.body(block.body).strainLambda) {
+  const StrainLambdas& lambdas = block.world.body(block.body).strainLambda;
+  ASSERT_GT(lambdas.size(), 0u);
+  for (std::size_t j = 0; j < lambdas.size(); ++j) {
+    const StrainLambda l = lambdas[j];
     EXPECT_NEAR(-l[0], expected, 1e-3f * expected);
     for (int c = 1; c < kStrainComponents; ++c) EXPECT_LT(std::abs(l[c]), 1e-3f * expected) << "component " << c;
   }
@@ -105,7 +108,10 @@ TEST(Strain, PureShearProducesOnlyShearMultipliers) {
   F.col(1) = Vec3(std::sin(0.02f), std::cos(0.02f), 0.0f);
   const HomogeneousBlock block(F);
   const float expected = std::sin(0.02f) / block.alphaTilde();
-  for (const StrainLambda& l : block.world.body(block.body).strainLambda) {
+  const StrainLambdas& lambdas = block.world.body(block.body).strainLambda;
+  ASSERT_GT(lambdas.size(), 0u);
+  for (std::size_t j = 0; j < lambdas.size(); ++j) {
+    const StrainLambda l = lambdas[j];
     EXPECT_NEAR(-l[3], expected, 1e-3f * expected);
     for (int c : {0, 1, 2, 4, 5}) EXPECT_LT(std::abs(l[c]), 1e-3f * expected) << "component " << c;
   }

@@ -119,17 +119,24 @@ T fieldOf(const C* c, float C::*field) {
   }
 }
 
-/// W consecutive floats as lanes, and back.
+/// W consecutive floats as lanes, and back; with `count` < W only the first `count` (the rest of
+/// the lanes are zero when loaded and not stored).
 template <typename T>
-T loadLanes(const float* f) {
-  T v;
-  std::memcpy(&v, f, sizeof(T));
+T loadLanes(const float* f, std::size_t count = kWidth<T>) {
+  T v{};
+  if (count == kWidth<T>)
+    std::memcpy(&v, f, sizeof(T));
+  else
+    std::memcpy(&v, f, count * sizeof(float));
   return v;
 }
 template <typename T>
-void addLanes(float* f, T delta) {
-  const T v = loadLanes<T>(f) + delta;
-  std::memcpy(f, &v, sizeof(T));
+void addLanes(float* f, T delta, std::size_t count = kWidth<T>) {
+  const T v = loadLanes<T>(f, count) + delta;
+  if (count == kWidth<T>)
+    std::memcpy(f, &v, sizeof(T));
+  else
+    std::memcpy(f, &v, count * sizeof(float));
 }
 
 }  // namespace vrd::sweeps

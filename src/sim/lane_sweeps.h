@@ -19,7 +19,8 @@ struct LaneSweeps {
                    bool damped, const Range& r);
   void (*volume)(const VolumeConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau, bool damped,
                  const Range& r);
-  void (*strain)(const StrainConstraint* c, std::size_t begin, std::size_t end, StrainLambda* lambda,
+  /// lambda: StrainLambdas::data() of `tets` tets
+  void (*strain)(const StrainConstraint* c, std::size_t begin, std::size_t end, float* lambda, std::size_t tets,
                  const ConstraintDamping& damping, bool damped, const Range& r);
 };
 
@@ -35,10 +36,10 @@ LaneSweeps makeLaneSweeps() {
          const Range& r) {
         damped ? volume<T, true>(c, begin, end, lambda, tau, r) : volume<T, false>(c, begin, end, lambda, tau, r);
       },
-      [](const StrainConstraint* c, std::size_t begin, std::size_t end, StrainLambda* lambda,
+      [](const StrainConstraint* c, std::size_t begin, std::size_t end, float* lambda, std::size_t tets,
          const ConstraintDamping& damping, bool damped, const Range& r) {
-        damped ? strain<T, true>(c, begin, end, lambda, damping, r)
-               : strain<T, false>(c, begin, end, lambda, damping, r);
+        damped ? strain<T, true>(c, begin, end, lambda, tets, damping, r)
+               : strain<T, false>(c, begin, end, lambda, tets, damping, r);
       },
   };
 }

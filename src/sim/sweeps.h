@@ -97,7 +97,7 @@ struct Padded {
   }
 };
 
-/// Calls batch(count, arrays + i...) for items [begin, end) of the parallel arrays (any may be
+/// Calls batch(i, count, arrays + i...) for items [begin, end) of the parallel arrays (any may be
 /// null), kWidth<T> at a time (count = kWidth<T>); the last (end - begin) % kWidth<T> items go on
 /// copies padded with the first one's (count = how many are real), and the padding's results are
 /// dropped.
@@ -106,11 +106,11 @@ void forBatches(std::size_t begin, std::size_t end, Batch batch, A*... arrays) {
   constexpr std::size_t W = kWidth<T>;
   const auto at = [](auto* array, std::size_t i) { return array ? array + i : nullptr; };
   std::size_t i = begin;
-  for (; i + W <= end; i += W) batch(W, at(arrays, i)...);
+  for (; i + W <= end; i += W) batch(i, W, at(arrays, i)...);
   if (i == end) return;
   const std::size_t count = end - i;
   [&](Padded<W, A>... padded) {
-    batch(count, padded.data()...);
+    batch(i, count, padded.data()...);
     (padded.writeBack(count), ...);
   }(Padded<W, A>(arrays, i, count)...);
 }
@@ -118,7 +118,7 @@ void forBatches(std::size_t begin, std::size_t end, Batch batch, A*... arrays) {
 template <typename T, bool Damped>
 [[gnu::flatten]] void distance(const DistanceConstraint* constraints, std::size_t begin, std::size_t end,
                                float* lambdas, float tau, const Range& r) {
-  const auto batch = [&](std::size_t count, const DistanceConstraint* c, float* lambda) {
+  const auto batch = [&](std::size_t, std::size_t count, const DistanceConstraint* c, float* lambda) {
     Gathered<T, 2, Damped> g(c, count, r.pred, r.start);
     const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &DistanceConstraint::compliance), splat<T>(tau), r.invH);
     const auto out = solveDistance(g.x, g.w, fieldOf<T>(c, &DistanceConstraint::restLength), loadLanes<T>(lambda), k,
@@ -133,7 +133,7 @@ template <typename T, bool Damped>
 template <typename T, bool Damped>
 [[gnu::flatten]] void volume(const VolumeConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
                              float tau, const Range& r) {
-  const auto batch = [&](std::size_t count, const VolumeConstraint* c, float* lambda) {
+  const auto batch = [&](std::size_t, std::size_t count, const VolumeConstraint* c, float* lambda) {
     Gathered<T, 4, Damped> g(c, count, r.pred, r.start);
     const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &VolumeConstraint::compliance), splat<T>(tau), r.invH);
     const auto out =
@@ -175,57 +175,11 @@ void strainWeightsOf(const StrainConstraint* c, VecOf<T> (&a)[4]) {
   }
 }
 
-// The six strain multipliers of one tet, or of kWidth<T> consecutive tets as lanes: per group of
-// four, the tets' 24 floats are contiguous, so components 0-3 and 2-5 of each tet load as one
-// vector each and two transposes give all six lanes.
-template <typename T>
-StrainLambdaT<T> loadStrainLambda(const StrainLambda* lambda) {
-  static_assert(sizeof(StrainLambda) == 6 * sizeof(float));
-  if constexpr (kWidth<T> == 1) {
-    return *lambda;
-  } else {
-    Lane4 part[kStrainComponents][kGroups<T>];
-    for (std::size_t g = 0; g < kGroups<T>; ++g) {
-      const float* f = reinterpret_cast<const float*>(lambda + 4 * g);
-      __m128 a0 = _mm_loadu_ps(f), a1 = _mm_loadu_ps(f + 6), a2 = _mm_loadu_ps(f + 12), a3 = _mm_loadu_ps(f + 18);
-      __m128 b0 = _mm_loadu_ps(f + 2), b1 = _mm_loadu_ps(f + 8), b2 = _mm_loadu_ps(f + 14), b3 = _mm_loadu_ps(f + 20);
-      _MM_TRANSPOSE4_PS(a0, a1, a2, a3);
-      _MM_TRANSPOSE4_PS(b0, b1, b2, b3);
-      part[0][g] = a0, part[1][g] = a1, part[2][g] = a2, part[3][g] = a3, part[4][g] = b2, part[5][g] = b3;
-    }
-    StrainLambdaT<T> out;
-    for (int c = 0; c < kStrainComponents; ++c) out[c] = concat<T>(part[c]);
-    return out;
-  }
-}
-
-template <typename T>
-void addStrainLambda(StrainLambda* lambda, const StrainLambdaT<T>& delta) {
-  if constexpr (kWidth<T> == 1) {
-    for (int c = 0; c < kStrainComponents; ++c) (*lambda)[c] += delta[c];
-  } else {
-    StrainLambdaT<T> sum = loadStrainLambda<T>(lambda);
-    Lane4 part[kStrainComponents][kGroups<T>];
-    for (int c = 0; c < kStrainComponents; ++c) split(T(sum[c] + delta[c]), part[c]);
-    for (std::size_t g = 0; g < kGroups<T>; ++g) {
-      __m128 a0 = part[0][g], a1 = part[1][g], a2 = part[2][g], a3 = part[3][g], b0 = part[4][g], b1 = part[5][g],
-             b2 = _mm_setzero_ps(), b3 = _mm_setzero_ps();
-      _MM_TRANSPOSE4_PS(a0, a1, a2, a3);  // a_l = components 0-3 of tet l
-      _MM_TRANSPOSE4_PS(b0, b1, b2, b3);  // b_l = components 4, 5 of tet l (and two zeros)
-      const __m128 low[4] = {a0, a1, a2, a3}, high[4] = {b0, b1, b2, b3};
-      for (std::size_t l = 0; l < 4; ++l) {
-        float* f = reinterpret_cast<float*>(lambda + 4 * g + l);
-        _mm_storeu_ps(f, low[l]);
-        _mm_storel_pi(reinterpret_cast<__m64*>(f + 4), high[l]);
-      }
-    }
-  }
-}
-
 template <typename T, bool Damped>
-[[gnu::flatten]] void strain(const StrainConstraint* constraints, std::size_t begin, std::size_t end,
-                             StrainLambda* lambdas, const ConstraintDamping& damping, const Range& r) {
-  const auto batch = [&](std::size_t count, const StrainConstraint* c, StrainLambda* lambda) {
+[[gnu::flatten]] void strain(const StrainConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
+                             std::size_t tets, const ConstraintDamping& damping, const Range& r) {
+  // lambdas: component k of tet j at [k * tets + j] (StrainLambdas)
+  const auto batch = [&](std::size_t first, std::size_t count, const StrainConstraint* c) {
     Gathered<T, 4, Damped> g(c, count, r.pred, r.start);
     VecOf<T> a[4];
     strainWeightsOf<T>(c, a);
@@ -233,12 +187,14 @@ template <typename T, bool Damped>
                                                     splat<T>(damping.strainStretch), r.invH);
     const auto shear = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &StrainConstraint::shearCompliance),
                                                   splat<T>(damping.strainShear), r.invH);
-    const auto out = solveStrain(g.x, g.w, a, loadStrainLambda<T>(lambda), stretch, shear, g.displacement());
-    addStrainLambda<T>(lambda, out.dLambda);
+    StrainLambdaT<T> lambda;
+    for (int k = 0; k < kStrainComponents; ++k) lambda[k] = loadLanes<T>(lambdas + k * tets + first, count);
+    const auto out = solveStrain(g.x, g.w, a, lambda, stretch, shear, g.displacement());
+    for (int k = 0; k < kStrainComponents; ++k) addLanes<T>(lambdas + k * tets + first, out.dLambda[k], count);
     g.move(out.dp);
     g.store(r.pred);
   };
-  forBatches<T>(begin, end, batch, constraints, lambdas);
+  forBatches<T>(begin, end, batch, constraints);
 }
 
 // Bending, one at a time (not batched: bending is the lighter part of a cloth).

@@ -36,7 +36,7 @@ void checkContactMode(FingertipContactMode mode, const char* what) {
 void clearMultipliers(Body& b) {
   std::fill(b.distanceLambda.begin(), b.distanceLambda.end(), 0.0f);
   std::fill(b.volumeLambda.begin(), b.volumeLambda.end(), 0.0f);
-  std::fill(b.strainLambda.begin(), b.strainLambda.end(), StrainLambda{});
+  b.strainLambda.zero();
   std::fill(b.bendLambda.begin(), b.bendLambda.end(), 0.0f);
   std::fill(b.shapeMatchLambda.begin(), b.shapeMatchLambda.end(), Vec3::Zero());
 }
@@ -63,7 +63,7 @@ BodyId World::addBody(std::shared_ptr<const BodyModel> model, const Vec3& transl
   body.particleCount = Index(model->particleCount());
   body.distanceLambda.assign(model->distance.size(), 0.0f);
   body.volumeLambda.assign(model->volume.size(), 0.0f);
-  body.strainLambda.assign(model->strain.size(), StrainLambda{});
+  body.strainLambda.assign(model->strain.size());
   body.bendLambda.assign(model->bend.size(), 0.0f);
   body.shapeMatchLambda.assign(model->shapeMatching ? model->particleCount() : 0, Vec3::Zero());
   body.shapeMatchRotation = rotation.cast<double>();
@@ -389,7 +389,7 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
       const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f;
       sweepColours(m.tetColours, m.tetParts, m.strain.size(), plan, team,
                    [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
-                     s.strain(m.strain.data(), begin, end, b.strainLambda.data(), tau, damped, r);
+                     s.strain(m.strain.data(), begin, end, b.strainLambda.data(), m.strain.size(), tau, damped, r);
                    });
     }
     if (!m.volume.empty()) {
@@ -533,7 +533,7 @@ std::size_t World::bodyBytes(BodyId id) const {
   const Body& b = bodies_.at(id);
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   const std::size_t perParticle = 2 * sizeof(Point) + 2 * sizeof(Vec3);  // x, p, v, force
-  return b.model->bytes() + bytes(b.distanceLambda) + bytes(b.volumeLambda) + bytes(b.strainLambda) +
+  return b.model->bytes() + bytes(b.distanceLambda) + bytes(b.volumeLambda) + b.strainLambda.bytes() +
          bytes(b.bendLambda) + bytes(b.shapeMatchLambda) + bytes(b.initialPositions) + b.particleCount * perParticle;
 }
 

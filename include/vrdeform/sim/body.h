@@ -28,7 +28,7 @@ struct Body {
   // angles; the strain multipliers are per component (stretch 00, 11, 22, shear 01, 02, 12).
   std::vector<float> distanceLambda;
   std::vector<float> volumeLambda;
-  std::vector<StrainLambda> strainLambda;
+  StrainLambdas strainLambda;
   std::vector<float> bendLambda;
   std::vector<Vec3> shapeMatchLambda;
   Eigen::Quaterniond shapeMatchRotation = Eigen::Quaterniond::Identity();  ///< R of the last shape match (warm start)

@@ -5,8 +5,10 @@
 // C = S_ii - 1 (eq. 33, rest stretch s_i = 1) and three shear C = S_ij, i < j (eq. 34), each with
 // its own multiplier, solved one after another inside the tet (local Gauss-Seidel).
 
+#include <algorithm>
 #include <array>
 #include <utility>
+#include <vector>
 
 #include "vrdeform/sim/xpbd.h"
 
@@ -28,6 +30,27 @@ inline bool isStretchComponent(int c) { return c < 3; }
 template <typename T>
 using StrainLambdaT = std::array<T, kStrainComponents>;
 using StrainLambda = StrainLambdaT<float>;
+
+/// The strain multipliers of a body, component by component: component c of tet j at
+/// data()[c * size() + j], so that SIMD lanes load and store one component of consecutive tets
+/// as one vector (instead of transposing six-float records).
+class StrainLambdas {
+ public:
+  void assign(std::size_t tets) { count_ = tets, values_.assign(kStrainComponents * tets, 0.0f); }
+  void zero() { std::fill(values_.begin(), values_.end(), 0.0f); }
+  std::size_t size() const { return count_; }
+  StrainLambda operator[](std::size_t j) const {
+    StrainLambda l;
+    for (int c = 0; c < kStrainComponents; ++c) l[c] = values_[std::size_t(c) * count_ + j];
+    return l;
+  }
+  float* data() { return values_.data(); }
+  std::size_t bytes() const { return values_.capacity() * sizeof(float); }
+
+ private:
+  std::vector<float> values_;
+  std::size_t count_ = 0;
+};
 
 /// Per-particle weights a_k with F = sum_k p_k a_k^T: a_k is row k-1 of D_rest^-1 and
 /// a_0 = -(a_1 + a_2 + a_3). So grad_{p_k} S_ij = a_k[i] f_j + a_k[j] f_i for the columns f of F.
