@@ -43,29 +43,40 @@ TEST(Colouring, IsAPermutationOfBalancedIndependentColours) {
   EXPECT_FALSE(coloursIndependent(mesh.tets, {0, 8}));
 }
 
-TEST(Colouring, PartsShareNoParticleAndLeaveAThinSeam) {
+TEST(Colouring, TwoThreadGroupsShareNoParticleAndLeaveLittleToOneThread) {
   const TetMesh mesh = makeBoxTets(Vec3::Zero(), Vec3(1.0f, 2.0f, 1.0f), 12, 12, 12);  // 10,368 tets
   // The grid's vertices run x fastest and z slowest: only a cut across z keeps neighbours in memory
   // in one slab (y is the longest side), the first half of the vertices in slab 0.
-  const std::vector<std::uint8_t> slab = slabsOf(mesh.vertices, 2);
-  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) ASSERT_EQ(slab[v], 2 * v / mesh.vertices.size()) << v;
-  const Colouring c = colourConstraints(mesh.tets, 8, 16, slab);
+  const Slabs slabs = slabsOf(mesh.vertices, 2);
+  EXPECT_EQ(slabs.axis, 2);
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) ASSERT_EQ(slabs.of[v], 2 * v / mesh.vertices.size()) << v;
+  EXPECT_EQ(slabsOf(mesh.vertices, 2, 2).axis, 1);  // then y, the next slowest
+
+  const std::vector<std::uint8_t> group = twoThreadGroups(mesh.tets, mesh.vertices);
+  std::size_t size[5] = {};
+  for (std::uint8_t g : group) ++size[g];
+  // Halves of about equal size; the seam next to the cut, in halves: the cut runs through a layer
+  // of vertices, so up to two layers of cells; across both cuts up to two by two rows of cells.
+  EXPECT_NEAR(double(size[0]), double(size[1]), 0.1 * double(size[0]));
+  EXPECT_NEAR(double(size[2]), double(size[3]), 0.2 * double(size[2]));
+  EXPECT_LE(size[2] + size[3] + size[4], 2 * mesh.tets.size() / 12);
+  EXPECT_LE(size[4], 4 * 12 * 6u);
+
+  const Colouring c = colourConstraints(mesh.tets, 8, 16, group);
   std::vector<Tet> ordered;
   for (Index k : c.order) ordered.push_back(mesh.tets[k]);
-  ASSERT_EQ(c.partColours.size(), 3u);
-  EXPECT_TRUE(coloursIndependent(ordered, c.colourStart, c.partColours));
-  const auto tetsIn = [&](std::size_t from, std::size_t to) { return c.colourStart[to] - c.colourStart[from]; };
-  const std::size_t colours = c.colourStart.size() - 1, seam = tetsIn(c.partColours[2], colours);
-  for (std::size_t part = 0; part < 2; ++part)
-    for (std::uint32_t k = c.colourStart[c.partColours[part]]; k < c.colourStart[c.partColours[part + 1]]; ++k)
-      for (Index v : ordered[k]) ASSERT_EQ(slab[v], part);
-  // The seam: the cells next to the cut, which runs through the middle layer of vertices.
-  EXPECT_GE(seam, mesh.tets.size() / 12);
-  EXPECT_LE(seam, 2 * mesh.tets.size() / 12) << seam;
-  EXPECT_NEAR(double(tetsIn(0, c.partColours[1])), double(tetsIn(c.partColours[1], c.partColours[2])),
-              0.2 * double(mesh.tets.size()));
-  // The checker is not vacuous: a part's colour moved to the other part shares particles.
-  EXPECT_FALSE(coloursIndependent(ordered, c.colourStart, {0, c.partColours[1] + 1, c.partColours[2]}));
+  ASSERT_EQ(c.groupColours.size(), 6u);
+  EXPECT_TRUE(coloursIndependent(ordered, c.colourStart, c.groupColours));
+  // Each group's colours hold its constraints (but for a few left to the remainder).
+  for (std::size_t g = 0; g < 5; ++g) {
+    const std::size_t coloured = c.colourStart[c.groupColours[g + 1]] - c.colourStart[c.groupColours[g]];
+    EXPECT_LE(coloured, size[g]);
+    EXPECT_GE(coloured, size[g] * 9 / 10) << g;
+  }
+  // The checker is not vacuous: with group 0's last colour counted in group 1, the pair overlaps.
+  std::vector<std::uint32_t> moved = c.groupColours;
+  --moved[1];
+  EXPECT_FALSE(coloursIndependent(ordered, c.colourStart, moved));
 }
 
 TEST(Colouring, ModelWithDependentColourIsRejected) {
@@ -215,16 +226,16 @@ TEST(Lanes, EveryWidthAgreesWithTheReferenceLoops) {
   }
 }
 
-// Two threads sweep the body's two parts at once, three share each colour; either way constraints
+// Two threads sweep the body's groups two at a time, three share each colour; either way constraints
 // run at once only when they touch disjoint particles, so the result is bit for bit the one-thread
 // result.
 TEST(Lanes, ThreadsGiveTheOneThreadResultExactly) {
 #if defined(__SANITIZE_THREAD__)
   GTEST_SKIP() << "libgomp is not built for ThreadSanitizer; its barriers would be reported as races";
 #endif
-  const auto model = dampedBlock(10, {true, true, true, true});  // 6,000 tets: cut in two parts
-  ASSERT_EQ(model->tetParts.size(), 3u);
-  ASSERT_EQ(model->distanceParts.size(), 3u);
+  const auto model = dampedBlock(10, {true, true, true, true});  // 6,000 tets: in groups
+  ASSERT_EQ(model->tetGroups.size(), 6u);
+  ASSERT_EQ(model->distanceGroups.size(), 6u);
   SolverSettings s;
   const std::vector<Vec3> one = sagBlock(model, s, 5);
   for (int threads : {2, 3}) {

@@ -94,18 +94,17 @@ std::vector<T> permuted(const std::vector<T>& items, const std::vector<Index>& o
 // threads a barrier, and one this small would not fill their SIMD lanes.
 constexpr std::size_t kMinColourSize = 8;
 
-// Constraint arrays at least this long are cut in two parts (Colouring::partColours), one per
-// thread of a 2-core machine: a part has colours of about a hundred constraints or more, and its
-// thread sweeps them all before it waits; only the seam between the parts (a few percent) is left
-// to one thread. Smaller arrays share every colour between the threads.
+// Constraint arrays at least this long are cut in groups for two threads (twoThreadGroups): a
+// group has colours of about a hundred constraints or more, and its thread sweeps them all before
+// it waits. Smaller arrays share every colour between the threads.
 constexpr std::size_t kMinCutConstraints = 4096;
-constexpr int kParts = 2;
 
-// The colour order of `constraints`, cut in parts when there are enough of them.
+// The colour order of `constraints`, in groups for two threads when there are enough of them.
 template <std::size_t N>
 Colouring colourOrder(const std::vector<std::array<Index, N>>& constraints, const std::vector<Vec3>& rest) {
   const bool cut = constraints.size() >= kMinCutConstraints;
-  return colourConstraints(constraints, kMinColourSize, 16, cut ? slabsOf(rest, kParts) : std::vector<std::uint8_t>{});
+  return colourConstraints(constraints, kMinColourSize, 16,
+                           cut ? twoThreadGroups(constraints, rest) : std::vector<std::uint8_t>{});
 }
 
 // Puts the distance constraints in colour order.
@@ -114,14 +113,15 @@ void colourDistances(BodyModel& model, SolveOrder order) {
   const Colouring c = colourOrder(particlesOf(model.distance), model.restPositions);
   model.distance = permuted(model.distance, c.order);
   model.distanceColours = c.colourStart;
-  model.distanceParts = c.partColours;
+  model.distanceGroups = c.groupColours;
 }
 
 template <typename C>
 void checkColours(const char* what, const std::vector<C>& constraints, const std::vector<std::uint32_t>& colours,
-                  const std::vector<std::uint32_t>& parts) {
-  if (!constraints.empty() && !coloursIndependent(particlesOf(constraints), colours, parts))
-    throw Error(fmt::format("{} constraints: a colour or two parts share a particle", what));
+                  const std::vector<std::uint32_t>& groups) {
+  if (!constraints.empty() && !coloursIndependent(particlesOf(constraints), colours, groups))
+    throw Error(
+        fmt::format("{} constraints: two in one colour, or in two groups swept at once, share a particle", what));
 }
 
 }  // namespace
@@ -165,7 +165,7 @@ std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Materia
     const Colouring c = colourOrder(mesh.tets, mesh.vertices);
     model->tets = permuted(mesh.tets, c.order);
     model->tetColours = c.colourStart;
-    model->tetParts = c.partColours;
+    model->tetGroups = c.groupColours;
   } else {
     model->tets = mesh.tets;
   }
@@ -288,7 +288,7 @@ std::size_t bytesOf(const std::vector<T>& v) {
 std::size_t BodyModel::bytes() const {
   std::size_t n = bytesOf(restPositions) + bytesOf(invMass) + bytesOf(tets) + bytesOf(triangles) + bytesOf(surface) +
                   bytesOf(distance) + bytesOf(volume) + bytesOf(strain) + bytesOf(bend) + bytesOf(distanceColours) +
-                  bytesOf(tetColours) + bytesOf(distanceParts) + bytesOf(tetParts);
+                  bytesOf(tetColours) + bytesOf(distanceGroups) + bytesOf(tetGroups);
   if (shapeMatching) n += bytesOf(shapeMatching->restOffsets) + bytesOf(shapeMatching->mass);
   return n;
 }
@@ -344,9 +344,9 @@ void validateModel(const BodyModel& model) {
     if (!finiteNonNegative(sm->compliance)) throw Error("shape matching compliance must be finite and >= 0");
     if (!(sm->totalMass > 0.0f)) throw Error("shape matching needs a positive total mass");
   }
-  checkColours("distance", model.distance, model.distanceColours, model.distanceParts);
-  checkColours("volume", model.volume, model.tetColours, model.tetParts);
-  checkColours("strain", model.strain, model.tetColours, model.tetParts);
+  checkColours("distance", model.distance, model.distanceColours, model.distanceGroups);
+  checkColours("volume", model.volume, model.tetColours, model.tetGroups);
+  checkColours("strain", model.strain, model.tetColours, model.tetGroups);
   const ConstraintDamping& d = model.damping;
   for (float beta : {d.distance, d.volume, d.strainStretch, d.strainShear, d.bend, d.shapeMatching})
     if (!finiteNonNegative(beta)) throw Error(fmt::format("damping must be finite and >= 0, got {}", beta));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 
 namespace vrd {
 namespace {
@@ -109,21 +110,14 @@ Colouring colourAll(const std::vector<std::array<Index, N>>& constraints, std::s
 
 template <std::size_t N>
 Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints, std::size_t minColourSize,
-                            std::size_t batch, const std::vector<std::uint8_t>& partOf) {
-  if (partOf.empty()) return colourAll(constraints, minColourSize, batch);
-  // Group g < parts: the constraints wholly in part g; group `parts`: the seam.
-  const std::size_t parts = std::size_t(*std::max_element(partOf.begin(), partOf.end())) + 1;
-  std::vector<std::vector<Index>> members(parts + 1);
-  for (std::size_t k = 0; k < constraints.size(); ++k) {
-    std::size_t group = partOf.at(constraints[k][0]);
-    for (Index p : constraints[k])
-      if (partOf.at(p) != group) group = parts;
-    members[group].push_back(Index(k));
-  }
+                            std::size_t batch, const std::vector<std::uint8_t>& groupOf) {
+  if (groupOf.empty()) return colourAll(constraints, minColourSize, batch);
+  std::vector<std::vector<Index>> members(std::size_t(*std::max_element(groupOf.begin(), groupOf.end())) + 1);
+  for (std::size_t k = 0; k < constraints.size(); ++k) members[groupOf.at(k)].push_back(Index(k));
   Colouring out;
   std::vector<Index> remainder;
   for (const std::vector<Index>& group : members) {
-    out.partColours.push_back(std::uint32_t(out.colourStart.size()));
+    out.groupColours.push_back(std::uint32_t(out.colourStart.size()));
     std::vector<std::array<Index, N>> own;
     for (Index k : group) own.push_back(constraints[k]);
     const Colouring c = colourAll(own, minColourSize, batch);
@@ -133,42 +127,71 @@ Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints
     for (std::size_t i = 0; i < coloured; ++i) out.order.push_back(group[c.order[i]]);
     for (std::size_t i = coloured; i < c.order.size(); ++i) remainder.push_back(group[c.order[i]]);
   }
+  out.groupColours.push_back(std::uint32_t(out.colourStart.size()));
   if (out.colourStart.empty())
-    out.partColours.clear();  // no colour at all
+    out.groupColours.clear();  // no colour at all
   else
     out.colourStart.push_back(std::uint32_t(out.order.size()));
   out.order.insert(out.order.end(), remainder.begin(), remainder.end());
   return out;
 }
 
-std::vector<std::uint8_t> slabsOf(const std::vector<Vec3>& points, int parts) {
+Slabs slabsOf(const std::vector<Vec3>& points, int parts, int skipAxis) {
   const auto cut = [&](int axis) {
     std::vector<Index> byHeight(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) byHeight[i] = Index(i);
     std::stable_sort(byHeight.begin(), byHeight.end(),
                      [&](Index a, Index b) { return points[a][axis] < points[b][axis]; });
-    std::vector<std::uint8_t> slab(points.size());
+    Slabs slabs{std::vector<std::uint8_t>(points.size()), axis};
     for (std::size_t r = 0; r < byHeight.size(); ++r)
-      slab[byHeight[r]] = std::uint8_t(r * std::size_t(parts) / points.size());
-    return slab;
+      slabs.of[byHeight[r]] = std::uint8_t(r * std::size_t(parts) / points.size());
+    return slabs;
   };
-  // Neighbours in memory in different slabs share cache lines that both threads write: cut across
-  // the axis along which the points' order changes slab least often (a grid's slowest axis).
-  const auto changes = [](const std::vector<std::uint8_t>& slab) {
+  const auto changes = [](const Slabs& s) {
     std::size_t n = 0;
-    for (std::size_t i = 1; i < slab.size(); ++i) n += slab[i] != slab[i - 1];
+    for (std::size_t i = 1; i < s.of.size(); ++i) n += s.of[i] != s.of[i - 1];
     return n;
   };
-  std::vector<std::uint8_t> best = cut(0);
-  for (int axis = 1; axis < 3; ++axis)
-    if (std::vector<std::uint8_t> slab = cut(axis); changes(slab) < changes(best)) best = std::move(slab);
-  return best;
+  std::optional<Slabs> best;
+  for (int axis = 0; axis < 3; ++axis)
+    if (axis != skipAxis)
+      if (Slabs s = cut(axis); !best || changes(s) < changes(*best)) best = std::move(s);
+  return *best;
+}
+
+template <std::size_t N>
+std::vector<std::uint8_t> twoThreadGroups(const std::vector<std::array<Index, N>>& constraints,
+                                          const std::vector<Vec3>& rest) {
+  const auto within = [](const std::array<Index, N>& c, const std::vector<std::uint8_t>& slab) {
+    return std::all_of(c.begin(), c.end(), [&](Index p) { return slab[p] == slab[c[0]]; });
+  };
+  const Slabs first = slabsOf(rest, 2);
+  std::vector<std::uint8_t> group(constraints.size(), 4);
+  std::vector<char> inSeam(rest.size(), 0);
+  for (std::size_t k = 0; k < constraints.size(); ++k) {
+    if (within(constraints[k], first.of))
+      group[k] = first.of[constraints[k][0]];
+    else
+      for (Index p : constraints[k]) inSeam[p] = 1;
+  }
+  // The seam's particles (in index order, as slabsOf wants them), halved across another axis.
+  std::vector<Index> seam;
+  std::vector<Vec3> seamRest;
+  for (Index p = 0; p < rest.size(); ++p)
+    if (inSeam[p]) seam.push_back(p), seamRest.push_back(rest[p]);
+  if (seam.empty()) return group;
+  const Slabs second = slabsOf(seamRest, 2, first.axis);
+  std::vector<std::uint8_t> half(rest.size(), 0);
+  for (std::size_t i = 0; i < seam.size(); ++i) half[seam[i]] = second.of[i];
+  for (std::size_t k = 0; k < constraints.size(); ++k)
+    if (group[k] == 4 && within(constraints[k], half)) group[k] = std::uint8_t(2 + half[constraints[k][0]]);
+  return group;
 }
 
 template <std::size_t N>
 bool coloursIndependent(const std::vector<std::array<Index, N>>& constraints,
-                        const std::vector<std::uint32_t>& colourStart, const std::vector<std::uint32_t>& partColours) {
-  if (colourStart.empty()) return partColours.empty();
+                        const std::vector<std::uint32_t>& colourStart, const std::vector<std::uint32_t>& groupColours) {
+  if (colourStart.empty()) return groupColours.empty();
   if (colourStart.back() > constraints.size()) return false;
   Index particles = 0;
   for (const auto& c : constraints)
@@ -183,29 +206,35 @@ bool coloursIndependent(const std::vector<std::array<Index, N>>& constraints,
       for (Index p : constraints[c]) seenIn[p] = std::uint32_t(k);
     }
   }
-  if (partColours.empty()) return true;
-  // Parts: non-decreasing colour ranges, the seam's last; no particle in two parts.
+  if (groupColours.empty()) return true;
   const std::size_t colours = colourStart.size() - 1;
-  if (partColours.front() != 0 || partColours.back() > colours) return false;
-  std::vector<std::uint32_t> partOf(particles, kNone);
-  for (std::size_t part = 0; part + 1 < partColours.size(); ++part) {
-    if (partColours[part] > partColours[part + 1]) return false;
-    for (std::uint32_t c = colourStart[partColours[part]]; c < colourStart[partColours[part + 1]]; ++c)
-      for (Index p : constraints[c]) {
-        if (partOf[p] != kNone && partOf[p] != part) return false;
-        partOf[p] = std::uint32_t(part);
-      }
+  if (groupColours.front() != 0 || groupColours.back() != colours) return false;
+  for (std::size_t g = 0; g + 1 < groupColours.size(); ++g)
+    if (groupColours[g] > groupColours[g + 1]) return false;
+  // Groups 2L and 2L + 1: the particles of the first, then none of them in the second.
+  std::vector<std::uint32_t> pairOf(particles, kNone);
+  for (std::size_t g = 0; g + 2 < groupColours.size(); g += 2) {
+    const auto range = [&](std::size_t group) {
+      return std::pair{colourStart[groupColours[group]], colourStart[groupColours[group + 1]]};
+    };
+    for (auto [begin, end] = range(g); begin < end; ++begin)
+      for (Index p : constraints[begin]) pairOf[p] = std::uint32_t(g);
+    for (auto [begin, end] = range(g + 1); begin < end; ++begin)
+      for (Index p : constraints[begin])
+        if (pairOf[p] == g) return false;
   }
   return true;
 }
 
-template Colouring colourConstraints<2>(const std::vector<std::array<Index, 2>>&, std::size_t, std::size_t,
-                                        const std::vector<std::uint8_t>&);
-template Colouring colourConstraints<4>(const std::vector<std::array<Index, 4>>&, std::size_t, std::size_t,
-                                        const std::vector<std::uint8_t>&);
-template bool coloursIndependent<2>(const std::vector<std::array<Index, 2>>&, const std::vector<std::uint32_t>&,
-                                    const std::vector<std::uint32_t>&);
-template bool coloursIndependent<4>(const std::vector<std::array<Index, 4>>&, const std::vector<std::uint32_t>&,
-                                    const std::vector<std::uint32_t>&);
+#define VRD_COLOURING(N)                                                                                           \
+  template Colouring colourConstraints<N>(const std::vector<std::array<Index, N>>&, std::size_t, std::size_t,      \
+                                          const std::vector<std::uint8_t>&);                                       \
+  template std::vector<std::uint8_t> twoThreadGroups<N>(const std::vector<std::array<Index, N>>&,                  \
+                                                        const std::vector<Vec3>&);                                 \
+  template bool coloursIndependent<N>(const std::vector<std::array<Index, N>>&, const std::vector<std::uint32_t>&, \
+                                      const std::vector<std::uint32_t>&);
+VRD_COLOURING(2)
+VRD_COLOURING(4)
+#undef VRD_COLOURING
 
 }  // namespace vrd

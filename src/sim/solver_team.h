@@ -19,6 +19,7 @@ struct SolverTeam {
   static SolverTeam current() { return {omp_get_thread_num(), omp_get_num_threads()}; }
 
   bool leader() const { return index == 0; }
+  bool last() const { return index + 1 == size; }
   /// Waits until every member has reached it; nothing in a team of one.
   void barrier() const {
     if (size > 1) {

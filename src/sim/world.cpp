@@ -328,25 +328,33 @@ void World::solveIterations(float h) {
 namespace {
 
 // One constraint array in colour order: each colour shared by the team and run through the lanes
-// (LanePlan::run), then the remainder one at a time by the leader. A body cut in parts, with no
-// more threads than parts, is swept part by part instead: each member takes whole parts, colour
-// after colour, then the leader does the seam. The order within each part and of the parts'
-// colours is the same either way, so the result does not depend on the team's size.
+// (LanePlan::run), then the remainder one at a time. A body cut in groups for two threads
+// (twoThreadGroups), with a team of two, is swept a pair of groups at a time instead: one group
+// each, colour after colour, with a barrier only after each pair; a last unpaired group and the
+// remainder go to the last member (the leader has the body's serial work: shape matching,
+// contacts). Within a pair the groups share no particle, so the result is the one-thread result.
 // `project(sweeps, begin, end)` calls the array's sweep of that width.
 template <typename Project>
-void sweepColours(const std::vector<std::uint32_t>& colours, const std::vector<std::uint32_t>& parts, std::size_t count,
-                  const sweeps::LanePlan& plan, const SolverTeam& team, Project project) {
+void sweepColours(const std::vector<std::uint32_t>& colours, const std::vector<std::uint32_t>& groups,
+                  std::size_t count, const sweeps::LanePlan& plan, const SolverTeam& team, Project project) {
   const std::size_t remainder = colours.empty() ? 0 : colours.back();
-  const std::size_t partCount = parts.empty() ? 0 : parts.size() - 1;
-  if (team.size > 1 && std::size_t(team.size) <= partCount) {
-    for (std::size_t p = std::size_t(team.index); p < partCount; p += std::size_t(team.size))
-      for (std::size_t k = parts[p]; k < parts[p + 1]; ++k) plan.run(colours[k], colours[k + 1], project);
-    team.barrier();
-    if (team.leader()) {
-      for (std::size_t k = parts.back(); k + 1 < colours.size(); ++k) plan.run(colours[k], colours[k + 1], project);
-      if (remainder < count) project(sweeps::scalarSweeps(), remainder, count);
+  if (team.size == 2 && !groups.empty()) {
+    const auto sweepGroup = [&](std::size_t g) {
+      for (std::size_t k = groups[g]; k < groups[g + 1]; ++k) plan.run(colours[k], colours[k + 1], project);
+    };
+    const std::size_t groupCount = groups.size() - 1;
+    std::size_t g = 0;
+    for (; g + 1 < groupCount; g += 2) {
+      sweepGroup(g + std::size_t(team.index));
+      team.barrier();
     }
-    team.barrier();
+    if (g < groupCount || remainder < count) {
+      if (team.last()) {
+        if (g < groupCount) sweepGroup(g);
+        if (remainder < count) project(sweeps::scalarSweeps(), remainder, count);
+      }
+      team.barrier();
+    }
     return;
   }
   constexpr std::size_t kAlign = 16;  // the widest lanes: every share but the last holds whole batches
@@ -377,7 +385,7 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
     if (!m.distance.empty()) {
       StageTimer t(times, Stage::Distance, timed);
       const bool damped = tau.distance > 0.0f;
-      sweepColours(m.distanceColours, m.distanceParts, m.distance.size(), plan, team,
+      sweepColours(m.distanceColours, m.distanceGroups, m.distance.size(), plan, team,
                    [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
                      s.distance(m.distance.data(), begin, end, b.distanceLambda.data(), tau.distance, damped, r);
                    });
@@ -387,7 +395,7 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
     if (!m.strain.empty()) {
       StageTimer t(times, Stage::Strain, timed);
       const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f;
-      sweepColours(m.tetColours, m.tetParts, m.strain.size(), plan, team,
+      sweepColours(m.tetColours, m.tetGroups, m.strain.size(), plan, team,
                    [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
                      s.strain(m.strain.data(), begin, end, b.strainLambda.data(), m.strain.size(), tau, damped, r);
                    });
@@ -395,7 +403,7 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
     if (!m.volume.empty()) {
       StageTimer t(times, Stage::Volume, timed);
       const bool damped = tau.volume > 0.0f;
-      sweepColours(m.tetColours, m.tetParts, m.volume.size(), plan, team,
+      sweepColours(m.tetColours, m.tetGroups, m.volume.size(), plan, team,
                    [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
                      s.volume(m.volume.data(), begin, end, b.volumeLambda.data(), tau.volume, damped, r);
                    });

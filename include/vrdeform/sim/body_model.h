@@ -57,9 +57,9 @@ struct BodyModel {
   /// strain): the solver projects a colour's constraints at once, in SIMD lanes and across threads,
   /// and the rest one at a time. Empty (hand-built models, SolveOrder::Mesh): all one at a time.
   std::vector<std::uint32_t> distanceColours, tetColours;
-  /// Their parts (Colouring::partColours): a big body is cut in two halves that two threads sweep
-  /// at once, without waiting for each other after every colour. Empty: not cut.
-  std::vector<std::uint32_t> distanceParts, tetParts;
+  /// Their groups (Colouring::groupColours, twoThreadGroups): a big body is cut in halves that two
+  /// threads sweep at once, without waiting for each other after every colour. Empty: not cut.
+  std::vector<std::uint32_t> distanceGroups, tetGroups;
 
   ConstraintDamping damping;
   float particleRadius = 0.0f;  ///< contact offset against colliders (m)

@@ -17,11 +17,9 @@ namespace vrd {
 struct Colouring {
   std::vector<Index> order;                ///< a permutation of the constraints
   std::vector<std::uint32_t> colourStart;  ///< colours + 1 entries; empty: all in the remainder
-  /// With parts (partOf below), one entry per part and one for the seam: colours
-  /// [partColours[p], partColours[p + 1]) hold the constraints whose particles all lie in part p,
-  /// and the colours from partColours.back() on the seam's (constraints across parts). Parts share
-  /// no particle, so each may be swept whole by its own thread while the others sweep theirs.
-  std::vector<std::uint32_t> partColours;
+  /// With groups (groupOf below): colours [groupColours[g], groupColours[g + 1]) hold group g's
+  /// constraints, groups + 1 entries. Empty: no groups.
+  std::vector<std::uint32_t> groupColours;
 };
 
 /// Greedy colouring that balances the colours: each constraint, in input order, joins the
@@ -30,23 +28,35 @@ struct Colouring {
 /// multiple of `batch` (the widest SIMD lanes) into other such colours, so that fewer batches run
 /// with idle lanes. Within a colour the input order is kept (neighbouring constraints stay near
 /// each other in memory). Colours with fewer than `minColourSize` constraints go to the remainder.
-/// With `partOf` (each particle's part, from 0): each part's constraints are coloured on their own,
-/// part after part, then the seam's.
+/// With `groupOf` (each constraint's group, from 0): each group is coloured on its own, group after
+/// group.
 template <std::size_t N>
 Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints, std::size_t minColourSize,
-                            std::size_t batch = 16, const std::vector<std::uint8_t>& partOf = {});
+                            std::size_t batch = 16, const std::vector<std::uint8_t>& groupOf = {});
 
-/// Cuts points into `parts` slabs of (nearly) equal count across x, y or z, whichever puts the
-/// fewest neighbours in the points' order into different slabs (threads sweeping different slabs
-/// then seldom write the same cache line): each point's slab, from 0.
-std::vector<std::uint8_t> slabsOf(const std::vector<Vec3>& points, int parts);
+/// Points cut into `parts` slabs of (nearly) equal count across x, y or z (not `skipAxis`),
+/// whichever puts the fewest neighbours in the points' order into different slabs: threads
+/// sweeping different slabs then seldom write the same cache line.
+struct Slabs {
+  std::vector<std::uint8_t> of;  ///< each point's slab, from 0
+  int axis = 0;
+};
+Slabs slabsOf(const std::vector<Vec3>& points, int parts, int skipAxis = -1);
+
+/// Groups for two threads (Colouring::groupColours), by the particles' rest positions: 0 and 1,
+/// the constraints wholly in one half of the body; 2 and 3, those across the cut but wholly in one
+/// half of a second cut across the first (the seam, halved); 4, those across both cuts. Groups 0
+/// and 1 share no particle, nor do 2 and 3, so two threads can sweep each pair at once.
+template <std::size_t N>
+std::vector<std::uint8_t> twoThreadGroups(const std::vector<std::array<Index, N>>& constraints,
+                                          const std::vector<Vec3>& rest);
 
 /// True when colourStart is non-decreasing within [0, constraints.size()], no two constraints of
-/// one colour [colourStart[k], colourStart[k + 1]) share a particle and, with partColours, no two
-/// constraints of different parts do.
+/// one colour [colourStart[k], colourStart[k + 1]) share a particle and, with groupColours, the
+/// groups cover the colours in order and groups 2L and 2L + 1 share no particle.
 template <std::size_t N>
 bool coloursIndependent(const std::vector<std::array<Index, N>>& constraints,
                         const std::vector<std::uint32_t>& colourStart,
-                        const std::vector<std::uint32_t>& partColours = {});
+                        const std::vector<std::uint32_t>& groupColours = {});
 
 }  // namespace vrd
