@@ -327,18 +327,30 @@ void World::solveIterations(float h) {
 
 namespace {
 
-// One constraint array in colour order: each colour shared by the team and run through the lanes
-// (LanePlan::run), then the remainder one at a time. A body cut in groups for two threads
-// (twoThreadGroups), with a team of two, is swept a pair of groups at a time instead: one group
-// each, colour after colour, with a barrier only after each pair; a last unpaired group and the
-// remainder go to the last member (the leader has the body's serial work: shape matching,
-// contacts). Within a pair the groups share no particle, so the result is the one-thread result.
+// One constraint array in colour order (colours run through the lanes by LanePlan::run, then the
+// remainder one at a time), by a team of threads:
+//  - an array too small to be cut in groups (body_model.cpp) by the last member alone, the others
+//    waiting once: a barrier per colour would cost more than the colour;
+//  - one cut in groups for two threads (twoThreadGroups), by a team of two, a pair of groups at a
+//    time: one group each, colour after colour, with a barrier only after each pair; a last
+//    unpaired group and the remainder by the last member;
+//  - otherwise each colour shared by the team, a barrier after each.
+// The last member, because the leader has the body's serial work (shape matching, contacts). Only
+// constraints that share no particle run at once, so the result is the one-thread result.
 // `project(sweeps, begin, end)` calls the array's sweep of that width.
 template <typename Project>
 void sweepColours(const std::vector<std::uint32_t>& colours, const std::vector<std::uint32_t>& groups,
                   std::size_t count, const sweeps::LanePlan& plan, const SolverTeam& team, Project project) {
   const std::size_t remainder = colours.empty() ? 0 : colours.back();
-  if (team.size == 2 && !groups.empty()) {
+  if (team.size > 1 && groups.empty()) {
+    if (team.last()) {
+      for (std::size_t k = 0; k + 1 < colours.size(); ++k) plan.run(colours[k], colours[k + 1], project);
+      if (remainder < count) project(sweeps::scalarSweeps(), remainder, count);
+    }
+    team.barrier();
+    return;
+  }
+  if (team.size == 2) {
     const auto sweepGroup = [&](std::size_t g) {
       for (std::size_t k = groups[g]; k < groups[g + 1]; ++k) plan.run(colours[k], colours[k + 1], project);
     };
