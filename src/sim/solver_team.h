@@ -1,8 +1,9 @@
 #pragma once
 // The threads that solve one substep together (SolverSettings::threads): an OpenMP team, each
-// member running the same sweep and taking its share of every colour, with a barrier between
-// colours. Constraints of one colour share no particle, so the shares never touch the same memory
-// and the result is bit for bit the one-thread result.
+// member running the same sweep and taking its share of the work (sweepColours in world.cpp: a
+// group of a big body's constraints, or a share of every colour), with barriers between the parts
+// that may touch the same particles. What runs at once shares no particle, so the result is bit for
+// bit the one-thread result.
 
 #include <omp.h>
 

@@ -40,8 +40,9 @@ struct SolverSettings {
   bool timeStages = true;  ///< record per-stage wall-clock times (a few dozen clock reads per step)
   /// Lanes for each colour's constraints: the same Gauss-Seidel sweep as Off, up to rounding.
   SimdLevel simd = SimdLevel::Best;
-  /// Threads that share each colour's constraints (OpenMP); the result does not depend on it.
-  /// Worth it for bodies of several thousand tets; 1 runs on the calling thread alone.
+  /// Solver threads (OpenMP): 2 sweep the halves of a big body at once, more share each colour;
+  /// the result does not depend on it. Worth it for bodies of several thousand tets; 1 runs on the
+  /// calling thread alone.
   int threads = 1;
 
   float substepSize() const { return timeStep / float(substeps); }
