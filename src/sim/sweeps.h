@@ -4,7 +4,6 @@
 // or a lane type (lanes.h: kWidth<T> consecutive constraints of one colour at once, which is the
 // same sweep as taking them one by one). Bending and shape matching run one at a time.
 
-#include <algorithm>
 #include <cstddef>
 #include <type_traits>
 
@@ -79,70 +78,49 @@ struct Range {
   float invH;          // 1/h
 };
 
-/// W items of an array from `first`, the missing ones at its end copies of the first; a mutable
-/// array's real items are copied back by writeBack(). A null array stays null.
-template <std::size_t W, typename A>
-struct Padded {
-  std::remove_const_t<A> items[W];
-  A* source;
-
-  Padded(A* array, std::size_t first, std::size_t count) : source(array ? array + first : nullptr) {
-    if (source)
-      for (std::size_t l = 0; l < W; ++l) items[l] = source[l < count ? l : 0];
-  }
-  A* data() { return source ? items : nullptr; }
-  void writeBack(std::size_t count) const {
-    if constexpr (!std::is_const_v<A>)
-      if (source) std::copy_n(items, count, source);
-  }
-};
-
-/// Calls batch(i, count, arrays + i...) for items [begin, end) of the parallel arrays (any may be
-/// null), kWidth<T> at a time (count = kWidth<T>); the last (end - begin) % kWidth<T> items go on
-/// copies padded with the first one's (count = how many are real), and the padding's results are
-/// dropped.
-template <typename T, typename Batch, typename... A>
-void forBatches(std::size_t begin, std::size_t end, Batch batch, A*... arrays) {
+/// Calls batch(i, count, c) for constraints [begin, end), kWidth<T> at a time from c = constraints
+/// + i (count = kWidth<T>); the last (end - begin) % kWidth<T> go on a copy padded with the first
+/// one (count = how many are real), whose padding's results the batch drops (multipliers by
+/// loadLanes/addLanes with `count`, positions by Gathered::store).
+template <typename T, typename C, typename Batch>
+void forBatches(const C* constraints, std::size_t begin, std::size_t end, Batch batch) {
   constexpr std::size_t W = kWidth<T>;
-  const auto at = [](auto* array, std::size_t i) { return array ? array + i : nullptr; };
   std::size_t i = begin;
-  for (; i + W <= end; i += W) batch(i, W, at(arrays, i)...);
+  for (; i + W <= end; i += W) batch(i, W, constraints + i);
   if (i == end) return;
-  const std::size_t count = end - i;
-  [&](Padded<W, A>... padded) {
-    batch(i, count, padded.data()...);
-    (padded.writeBack(count), ...);
-  }(Padded<W, A>(arrays, i, count)...);
+  C padded[W];
+  for (std::size_t l = 0; l < W; ++l) padded[l] = constraints[l < end - i ? i + l : i];
+  batch(i, end - i, padded);
 }
 
 template <typename T, bool Damped>
 [[gnu::flatten]] void distance(const DistanceConstraint* constraints, std::size_t begin, std::size_t end,
                                float* lambdas, float tau, const Range& r) {
-  const auto batch = [&](std::size_t, std::size_t count, const DistanceConstraint* c, float* lambda) {
+  const auto batch = [&](std::size_t first, std::size_t count, const DistanceConstraint* c) {
     Gathered<T, 2, Damped> g(c, count, r.pred, r.start);
     const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &DistanceConstraint::compliance), splat<T>(tau), r.invH);
-    const auto out = solveDistance(g.x, g.w, fieldOf<T>(c, &DistanceConstraint::restLength), loadLanes<T>(lambda), k,
-                                   g.displacement());
-    addLanes<T>(lambda, out.dLambda);
+    const auto out = solveDistance(g.x, g.w, fieldOf<T>(c, &DistanceConstraint::restLength),
+                                   loadLanes<T>(lambdas + first, count), k, g.displacement());
+    addLanes<T>(lambdas + first, out.dLambda, count);
     g.move(out.dp);
     g.store(r.pred);
   };
-  forBatches<T>(begin, end, batch, constraints, lambdas);
+  forBatches<T>(constraints, begin, end, batch);
 }
 
 template <typename T, bool Damped>
 [[gnu::flatten]] void volume(const VolumeConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
                              float tau, const Range& r) {
-  const auto batch = [&](std::size_t, std::size_t count, const VolumeConstraint* c, float* lambda) {
+  const auto batch = [&](std::size_t first, std::size_t count, const VolumeConstraint* c) {
     Gathered<T, 4, Damped> g(c, count, r.pred, r.start);
     const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &VolumeConstraint::compliance), splat<T>(tau), r.invH);
-    const auto out =
-        solveVolume(g.x, g.w, fieldOf<T>(c, &VolumeConstraint::restVolume), loadLanes<T>(lambda), k, g.displacement());
-    addLanes<T>(lambda, out.dLambda);
+    const auto out = solveVolume(g.x, g.w, fieldOf<T>(c, &VolumeConstraint::restVolume),
+                                 loadLanes<T>(lambdas + first, count), k, g.displacement());
+    addLanes<T>(lambdas + first, out.dLambda, count);
     g.move(out.dp);
     g.store(r.pred);
   };
-  forBatches<T>(begin, end, batch, constraints, lambdas);
+  forBatches<T>(constraints, begin, end, batch);
 }
 
 // Strain weights a_k (strainWeights) of one tet or of kWidth<T> tets. For lanes, per group of
@@ -194,7 +172,7 @@ template <typename T, bool Damped>
     g.move(out.dp);
     g.store(r.pred);
   };
-  forBatches<T>(begin, end, batch, constraints);
+  forBatches<T>(constraints, begin, end, batch);
 }
 
 // Bending, one at a time (not batched: bending is the lighter part of a cloth).
