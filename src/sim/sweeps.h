@@ -93,14 +93,15 @@ void forBatches(const C* constraints, std::size_t begin, std::size_t end, Batch 
   batch(i, end - i, padded);
 }
 
-template <typename T, bool Damped>
-[[gnu::flatten]] void distance(const DistanceConstraint* constraints, std::size_t begin, std::size_t end,
-                               float* lambdas, float tau, const Range& r) {
-  const auto batch = [&](std::size_t first, std::size_t count, const DistanceConstraint* c) {
-    Gathered<T, 2, Damped> g(c, count, r.pred, r.start);
-    const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &DistanceConstraint::compliance), splat<T>(tau), r.invH);
-    const auto out = solveDistance(g.x, g.w, fieldOf<T>(c, &DistanceConstraint::restLength),
-                                   loadLanes<T>(lambdas + first, count), k, g.displacement());
+// A constraint type with one multiplier per constraint over N particles (distance, volume):
+// `solve` is its projection (solveDistance, solveVolume), `rest` its rest value's field.
+template <typename T, bool Damped, std::size_t N, typename C, typename Solve>
+void oneMultiplier(const C* constraints, std::size_t begin, std::size_t end, float* lambdas, float tau, const Range& r,
+                   float C::*rest, Solve solve) {
+  const auto batch = [&](std::size_t first, std::size_t count, const C* c) {
+    Gathered<T, N, Damped> g(c, count, r.pred, r.start);
+    const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &C::compliance), splat<T>(tau), r.invH);
+    const auto out = solve(g.x, g.w, fieldOf<T>(c, rest), loadLanes<T>(lambdas + first, count), k, g.displacement());
     addLanes<T>(lambdas + first, out.dLambda, count);
     g.move(out.dp);
     g.store(r.pred);
@@ -109,18 +110,17 @@ template <typename T, bool Damped>
 }
 
 template <typename T, bool Damped>
+[[gnu::flatten]] void distance(const DistanceConstraint* constraints, std::size_t begin, std::size_t end,
+                               float* lambdas, float tau, const Range& r) {
+  oneMultiplier<T, Damped, 2>(constraints, begin, end, lambdas, tau, r, &DistanceConstraint::restLength,
+                              [](const auto&... a) { return solveDistance(a...); });
+}
+
+template <typename T, bool Damped>
 [[gnu::flatten]] void volume(const VolumeConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
                              float tau, const Range& r) {
-  const auto batch = [&](std::size_t first, std::size_t count, const VolumeConstraint* c) {
-    Gathered<T, 4, Damped> g(c, count, r.pred, r.start);
-    const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &VolumeConstraint::compliance), splat<T>(tau), r.invH);
-    const auto out = solveVolume(g.x, g.w, fieldOf<T>(c, &VolumeConstraint::restVolume),
-                                 loadLanes<T>(lambdas + first, count), k, g.displacement());
-    addLanes<T>(lambdas + first, out.dLambda, count);
-    g.move(out.dp);
-    g.store(r.pred);
-  };
-  forBatches<T>(constraints, begin, end, batch);
+  oneMultiplier<T, Damped, 4>(constraints, begin, end, lambdas, tau, r, &VolumeConstraint::restVolume,
+                              [](const auto&... a) { return solveVolume(a...); });
 }
 
 // Strain weights a_k (strainWeights) of one tet or of kWidth<T> tets. For lanes, per group of
