@@ -46,6 +46,7 @@ gravity = [0, -9.8, 0.5]
 linear_damping = 0.2
 simd = false
 threads = 2
+fuse_strain_volume = false
 
 [[body]]
 name = "liver"
@@ -204,6 +205,7 @@ TEST(SceneFile, FullSceneSetsEveryField) {
   EXPECT_FLOAT_EQ(s.solver.linearDamping, 0.2f);
   EXPECT_EQ(s.solver.simd, SimdLevel::Off);
   EXPECT_EQ(s.solver.threads, 2);
+  EXPECT_FALSE(s.solver.fuseStrainVolume);
 
   ASSERT_EQ(s.bodies.size(), 3u);
   const BodySpec& liver = s.bodies[0];
@@ -354,6 +356,7 @@ TEST(SceneFile, AbsentKeysKeepTheirDefaults) {
   EXPECT_EQ(s.solver.gravity, d.solver.gravity);
   EXPECT_EQ(s.solver.simd, SimdLevel::Best);
   EXPECT_EQ(s.solver.threads, 1);
+  EXPECT_TRUE(s.solver.fuseStrainVolume);
 
   ASSERT_EQ(s.bodies.size(), 1u);
   const BodySpec& b = s.bodies[0];

@@ -134,8 +134,8 @@ TEST(World, StageTimesCoverTheStagesThatRan) {
   w.addFingertip(Vec3(0.0f, 0.12f, 0.0f), 0.03f);
   w.step();
   const StageTimes& t = w.lastStep().times;
-  for (Stage s : {Stage::Predict, Stage::Detect, Stage::Volume, Stage::Strain, Stage::ShapeMatching, Stage::Attachment,
-                  Stage::Finalise})
+  for (Stage s :
+       {Stage::Predict, Stage::Detect, Stage::StrainVolume, Stage::ShapeMatching, Stage::Attachment, Stage::Finalise})
     EXPECT_GT(t[s], 0.0) << stageName(s);
   EXPECT_EQ(t[Stage::Distance], 0.0);  // no such constraints
   EXPECT_EQ(t[Stage::Bend], 0.0);

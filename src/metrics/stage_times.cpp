@@ -4,8 +4,8 @@ namespace vrd {
 
 std::string_view stageName(Stage stage) {
   static constexpr std::string_view kNames[kStageCount] = {
-      "predict",    "detect",  "distance",  "volume",   "strain",   "bend", "shape_matching",
-      "attachment", "contact", "fingertip", "finalise", "interact", "force"};
+      "predict",        "detect",     "distance", "volume",    "strain",   "strain_volume", "bend",
+      "shape_matching", "attachment", "contact",  "fingertip", "finalise", "interact",      "force"};
   return stage < Stage::Count ? kNames[std::size_t(stage)] : "?";
 }
 

@@ -385,7 +385,8 @@ void validateAt(const Table& t, std::string_view prefix, F&& validate) {
 }
 
 SolverSettings readSolver(const Table& t) {
-  t.allowOnly({"rate", "dt", "substeps", "iterations", "gravity", "linear_damping", "simd", "threads"});
+  t.allowOnly(
+      {"rate", "dt", "substeps", "iterations", "gravity", "linear_damping", "simd", "threads", "fuse_strain_volume"});
   t.exclusive("rate", "dt");
   SolverSettings s;
   if (std::optional<Field> f = t.get("rate")) s.timeStep = 1.0f / float(f->integer(1, 100000));
@@ -398,6 +399,7 @@ SolverSettings readSolver(const Table& t) {
   t.readBool("simd", simd);
   s.simd = simd ? SimdLevel::Best : SimdLevel::Off;
   t.readInt("threads", s.threads, 1, 256);
+  t.readBool("fuse_strain_volume", s.fuseStrainVolume);
   validateAt(t, "solver", [&] { validateSolverSettings(s); });
   return s;
 }

@@ -22,6 +22,10 @@ struct LaneSweeps {
   /// lambda: StrainLambdas::data() of `tets` tets
   void (*strain)(const StrainConstraint* c, std::size_t begin, std::size_t end, float* lambda, std::size_t tets,
                  const ConstraintDamping& damping, bool damped, const Range& r);
+  /// strain and volume of the same `tets` tets in one pass (strain_volume.h)
+  void (*strainVolume)(const StrainConstraint* strain, const VolumeConstraint* volume, std::size_t begin,
+                       std::size_t end, float* strainLambda, float* volumeLambda, std::size_t tets,
+                       const ConstraintDamping& damping, bool damped, const Range& r);
 };
 
 template <typename T>
@@ -40,6 +44,11 @@ LaneSweeps makeLaneSweeps() {
          const ConstraintDamping& damping, bool damped, const Range& r) {
         damped ? strain<T, true>(c, begin, end, lambda, tets, damping, r)
                : strain<T, false>(c, begin, end, lambda, tets, damping, r);
+      },
+      [](const StrainConstraint* s, const VolumeConstraint* v, std::size_t begin, std::size_t end, float* strainLambda,
+         float* volumeLambda, std::size_t tets, const ConstraintDamping& damping, bool damped, const Range& r) {
+        damped ? strainVolume<T, true>(s, v, begin, end, strainLambda, volumeLambda, tets, damping, r)
+               : strainVolume<T, false>(s, v, begin, end, strainLambda, volumeLambda, tets, damping, r);
       },
   };
 }

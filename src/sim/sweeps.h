@@ -4,11 +4,13 @@
 // or a lane type (lanes.h: kWidth<T> consecutive constraints of one colour at once, which is the
 // same sweep as taking them one by one). Bending and shape matching run one at a time.
 
+#include <array>
 #include <cstddef>
 #include <type_traits>
 
 #include "lane_io.h"
 #include "vrdeform/sim/body.h"
+#include "vrdeform/sim/strain_volume.h"
 
 namespace vrd::sweeps {
 
@@ -78,19 +80,23 @@ struct Range {
   float invH;          // 1/h
 };
 
-/// Calls batch(i, count, c) for constraints [begin, end), kWidth<T> at a time from c = constraints
-/// + i (count = kWidth<T>); the last (end - begin) % kWidth<T> go on a copy padded with the first
-/// one (count = how many are real), whose padding's results the batch drops (multipliers by
-/// loadLanes/addLanes with `count`, positions by Gathered::store).
-template <typename T, typename C, typename Batch>
-void forBatches(const C* constraints, std::size_t begin, std::size_t end, Batch batch) {
+/// Calls batch(i, count, c...) for constraints [begin, end) of one or more arrays of the same order,
+/// kWidth<T> at a time from c = constraints + i (count = kWidth<T>); the last (end - begin) %
+/// kWidth<T> go on copies padded with the first one (count = how many are real), whose padding's
+/// results the batch drops (multipliers by loadLanes/addLanes with `count`, positions by
+/// Gathered::store).
+template <typename T, typename Batch, typename... C>
+void forBatches(std::size_t begin, std::size_t end, Batch batch, const C*... constraints) {
   constexpr std::size_t W = kWidth<T>;
   std::size_t i = begin;
-  for (; i + W <= end; i += W) batch(i, W, constraints + i);
+  for (; i + W <= end; i += W) batch(i, W, (constraints + i)...);
   if (i == end) return;
-  C padded[W];
-  for (std::size_t l = 0; l < W; ++l) padded[l] = constraints[l < end - i ? i + l : i];
-  batch(i, end - i, padded);
+  const auto padded = [&]<typename K>(const K* c) {
+    std::array<K, W> p;
+    for (std::size_t l = 0; l < W; ++l) p[l] = c[l < end - i ? i + l : i];
+    return p;
+  };
+  [&](const auto&... p) { batch(i, end - i, p.data()...); }(padded(constraints)...);
 }
 
 // A constraint type with one multiplier per constraint over N particles (distance, volume):
@@ -106,7 +112,7 @@ void oneMultiplier(const C* constraints, std::size_t begin, std::size_t end, flo
     g.move(out.dp);
     g.store(r.pred);
   };
-  forBatches<T>(constraints, begin, end, batch);
+  forBatches<T>(begin, end, batch, constraints);
 }
 
 template <typename T, bool Damped>
@@ -153,26 +159,62 @@ void strainWeightsOf(const StrainConstraint* c, VecOf<T> (&a)[4]) {
   }
 }
 
+// The lanes of a strain batch: weights, the two coefficients and the six multipliers (component k of
+// tet j at lambdas[k * tets + j], StrainLambdas).
+template <typename T>
+struct StrainLanes {
+  VecOf<T> a[4];
+  XpbdCoefficientsT<T> stretch, shear;
+  StrainLambdaT<T> lambda;
+
+  StrainLanes(const StrainConstraint* c, const float* lambdas, std::size_t tets, std::size_t first, std::size_t count,
+              const ConstraintDamping& damping, float invH)
+      : stretch(XpbdCoefficientsT<T>::make(fieldOf<T>(c, &StrainConstraint::stretchCompliance),
+                                           splat<T>(damping.strainStretch), invH)),
+        shear(XpbdCoefficientsT<T>::make(fieldOf<T>(c, &StrainConstraint::shearCompliance),
+                                         splat<T>(damping.strainShear), invH)) {
+    strainWeightsOf<T>(c, a);
+    for (int k = 0; k < kStrainComponents; ++k) lambda[k] = loadLanes<T>(lambdas + k * tets + first, count);
+  }
+  static void add(float* lambdas, std::size_t tets, std::size_t first, std::size_t count,
+                  const StrainLambdaT<T>& dLambda) {
+    for (int k = 0; k < kStrainComponents; ++k) addLanes<T>(lambdas + k * tets + first, dLambda[k], count);
+  }
+};
+
 template <typename T, bool Damped>
 [[gnu::flatten]] void strain(const StrainConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
                              std::size_t tets, const ConstraintDamping& damping, const Range& r) {
-  // lambdas: component k of tet j at [k * tets + j] (StrainLambdas)
   const auto batch = [&](std::size_t first, std::size_t count, const StrainConstraint* c) {
     Gathered<T, 4, Damped> g(c, count, r.pred, r.start);
-    VecOf<T> a[4];
-    strainWeightsOf<T>(c, a);
-    const auto stretch = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &StrainConstraint::stretchCompliance),
-                                                    splat<T>(damping.strainStretch), r.invH);
-    const auto shear = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &StrainConstraint::shearCompliance),
-                                                  splat<T>(damping.strainShear), r.invH);
-    StrainLambdaT<T> lambda;
-    for (int k = 0; k < kStrainComponents; ++k) lambda[k] = loadLanes<T>(lambdas + k * tets + first, count);
-    const auto out = solveStrain(g.x, g.w, a, lambda, stretch, shear, g.displacement());
-    for (int k = 0; k < kStrainComponents; ++k) addLanes<T>(lambdas + k * tets + first, out.dLambda[k], count);
+    const StrainLanes<T> s(c, lambdas, tets, first, count, damping, r.invH);
+    const auto out = solveStrain(g.x, g.w, s.a, s.lambda, s.stretch, s.shear, g.displacement());
+    StrainLanes<T>::add(lambdas, tets, first, count, out.dLambda);
     g.move(out.dp);
     g.store(r.pred);
   };
-  forBatches<T>(constraints, begin, end, batch);
+  forBatches<T>(begin, end, batch, constraints);
+}
+
+// Strain and volume of the same tets in one pass (strain_volume.h): volume[j] belongs to strain[j].
+template <typename T, bool Damped>
+[[gnu::flatten]] void strainVolume(const StrainConstraint* strain, const VolumeConstraint* volume, std::size_t begin,
+                                   std::size_t end, float* strainLambdas, float* volumeLambdas, std::size_t tets,
+                                   const ConstraintDamping& damping, const Range& r) {
+  const auto batch = [&](std::size_t first, std::size_t count, const StrainConstraint* c, const VolumeConstraint* v) {
+    Gathered<T, 4, Damped> g(c, count, r.pred, r.start);
+    const StrainLanes<T> s(c, strainLambdas, tets, first, count, damping, r.invH);
+    const auto k =
+        XpbdCoefficientsT<T>::make(fieldOf<T>(v, &VolumeConstraint::compliance), splat<T>(damping.volume), r.invH);
+    const auto out =
+        solveStrainVolume(g.x, g.w, s.a, s.lambda, s.stretch, s.shear, fieldOf<T>(v, &VolumeConstraint::restVolume),
+                          loadLanes<T>(volumeLambdas + first, count), k, g.displacement());
+    StrainLanes<T>::add(strainLambdas, tets, first, count, out.dLambdaStrain);
+    addLanes<T>(volumeLambdas + first, out.dLambdaVolume, count);
+    g.move(out.dp);
+    g.store(r.pred);
+  };
+  forBatches<T>(begin, end, batch, strain, volume);
 }
 
 // Bending, one at a time (not batched: bending is the lighter part of a cloth).

@@ -404,21 +404,31 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
     }
     // Strain before volume: S = F^T F cannot tell a tet from its mirror image, so the signed
     // volume constraint gets the last word on orientation.
-    if (!m.strain.empty()) {
-      StageTimer t(times, Stage::Strain, timed);
-      const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f;
+    if (settings_.fuseStrainVolume && !m.strain.empty() && !m.volume.empty()) {
+      StageTimer t(times, Stage::StrainVolume, timed);
+      const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f || tau.volume > 0.0f;
       sweepColours(m.tetColours, m.tetGroups, m.strain.size(), plan, team,
                    [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
-                     s.strain(m.strain.data(), begin, end, b.strainLambda.data(), m.strain.size(), tau, damped, r);
+                     s.strainVolume(m.strain.data(), m.volume.data(), begin, end, b.strainLambda.data(),
+                                    b.volumeLambda.data(), m.strain.size(), tau, damped, r);
                    });
-    }
-    if (!m.volume.empty()) {
-      StageTimer t(times, Stage::Volume, timed);
-      const bool damped = tau.volume > 0.0f;
-      sweepColours(m.tetColours, m.tetGroups, m.volume.size(), plan, team,
-                   [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
-                     s.volume(m.volume.data(), begin, end, b.volumeLambda.data(), tau.volume, damped, r);
-                   });
+    } else {
+      if (!m.strain.empty()) {
+        StageTimer t(times, Stage::Strain, timed);
+        const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f;
+        sweepColours(m.tetColours, m.tetGroups, m.strain.size(), plan, team,
+                     [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
+                       s.strain(m.strain.data(), begin, end, b.strainLambda.data(), m.strain.size(), tau, damped, r);
+                     });
+      }
+      if (!m.volume.empty()) {
+        StageTimer t(times, Stage::Volume, timed);
+        const bool damped = tau.volume > 0.0f;
+        sweepColours(m.tetColours, m.tetGroups, m.volume.size(), plan, team,
+                     [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
+                       s.volume(m.volume.data(), begin, end, b.volumeLambda.data(), tau.volume, damped, r);
+                     });
+      }
     }
     if (!team.leader()) continue;  // the rest of the body runs one at a time
     if (!m.bend.empty()) {

@@ -14,6 +14,7 @@ enum class Stage : std::uint8_t {
   Distance,       ///< stretch constraints
   Volume,         ///< tet volume constraints
   Strain,         ///< tet strain constraints
+  StrainVolume,   ///< tet strain and volume constraints in one pass (SolverSettings::fuseStrainVolume)
   Bend,           ///< dihedral bending constraints
   ShapeMatching,  ///< global shape matching
   Attachment,     ///< attachments

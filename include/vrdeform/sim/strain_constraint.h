@@ -96,6 +96,73 @@ struct StrainCorrection {
   V dp[4];
 };
 
+/// The closed-form local solve of one tet's strain constraints (see solveStrain), kept as state so
+/// that further constraints on the same tet can follow it in the same pass (strain_volume.h):
+/// F's columns f (kept current as corrections are made), F at the start of the substep (damping),
+/// B = sum_k w_k a_k a_k^T, and U, which gathers the corrections: dp_k = w_k U a_k.
+template <typename V>
+struct TetLocalSolve {
+  using T = typename V::Scalar;
+  V f[3], fStart[3], U[3];
+  T B[3][3];
+  bool damped;
+
+  /// `disp`: each particle's motion since the start of the substep; null when undamped.
+  TetLocalSolve(const V (&x)[4], const T (&w)[4], const V (&a)[4], const V* disp) : damped(disp != nullptr) {
+    for (int i = 0; i < 3; ++i) {
+      f[i] = a[0][i] * x[0] + a[1][i] * x[1] + a[2][i] * x[2] + a[3][i] * x[3];
+      // The displacement gradient is F - F(start) = sum_k disp_k a_k^T.
+      fStart[i] = disp ? V(f[i] - (a[0][i] * disp[0] + a[1][i] * disp[1] + a[2][i] * disp[2] + a[3][i] * disp[3]))
+                       : V(V::Zero());
+      U[i] = V::Zero();
+      for (int j = i; j < 3; ++j)
+        B[i][j] = B[j][i] =
+            w[0] * a[0][i] * a[0][j] + w[1] * a[1][i] * a[1][j] + w[2] * a[2][i] * a[2][j] + w[3] * a[3][i] * a[3][j];
+    }
+  }
+
+  /// Eqs. 33-34: projects the six strain components one after another; returns their dLambda.
+  StrainLambdaT<T> strain(const StrainLambdaT<T>& lambda, const XpbdCoefficientsT<T>& stretch,
+                          const XpbdCoefficientsT<T>& shear) {
+    StrainLambdaT<T> dLambda;
+    [&]<int... c>(std::integer_sequence<int, c...>) { ((dLambda[c] = component<c>(lambda[c], stretch, shear)), ...); }
+    (std::make_integer_sequence<int, kStrainComponents>{});
+    return dLambda;
+  }
+
+  /// The particles' corrections so far: dp_k = w_k U a_k.
+  void corrections(const T (&w)[4], const V (&a)[4], V (&dp)[4]) const {
+    for (int k = 0; k < 4; ++k) dp[k] = w[k] * V(a[k][0] * U[0] + a[k][1] * U[1] + a[k][2] * U[2]);
+  }
+
+ private:
+  // One component; c is a template argument so that i and j are constants and f, B and U stay in
+  // registers (a runtime loop over kStrainAxes keeps them in memory).
+  template <int c>
+  T component(T lambda, const XpbdCoefficientsT<T>& stretch, const XpbdCoefficientsT<T>& shear) {
+    constexpr int i = kStrainAxes[c][0], j = kStrainAxes[c][1];
+    const T Sij = f[i].dot(f[j]);
+    if constexpr (i == j) {
+      // grad C . disp = f_j.D_i + f_i.D_j with the displacement gradient D = F - F(start).
+      const T gradDotDisp = damped ? T(2.0f * f[i].dot(f[i] - fStart[i])) : splat<T>(0.0);
+      const T dLambda = deltaLambda(T(Sij - 1.0f), lambda, T(4.0f * B[i][i] * Sij), stretch, gradDotDisp);
+      const V gi = (2.0f * dLambda) * f[i];  // the change of U's column i
+      U[i] += gi;
+      for (int m = 0; m < 3; ++m) f[m] += B[i][m] * gi;  // F += gi B_i. (the rank-1 change of F)
+      return dLambda;
+    } else {
+      const T gradMinvGrad = B[i][i] * f[j].squaredNorm() + B[j][j] * f[i].squaredNorm() + 2.0f * B[i][j] * Sij;
+      const T gradDotDisp = damped ? T(f[j].dot(f[i] - fStart[i]) + f[i].dot(f[j] - fStart[j])) : splat<T>(0.0);
+      const T dLambda = deltaLambda(Sij, lambda, gradMinvGrad, shear, gradDotDisp);
+      const V gi = dLambda * f[j], gj = dLambda * f[i];  // the changes of U's columns i and j
+      U[i] += gi;
+      U[j] += gj;
+      for (int m = 0; m < 3; ++m) f[m] += B[i][m] * gi + B[j][m] * gj;  // F += gi B_i. + gj B_j.
+      return dLambda;
+    }
+  }
+};
+
 /// One local Gauss-Seidel sweep over the six strain constraints of a tet, for particles x with
 /// inverse masses w and strain weights a (see strainWeights).
 ///
@@ -109,47 +176,10 @@ StrainCorrection<V> solveStrain(const V (&x)[4], const typename V::Scalar (&w)[4
                                 const StrainLambdaT<typename V::Scalar>& lambda,
                                 const XpbdCoefficientsT<typename V::Scalar>& stretch,
                                 const XpbdCoefficientsT<typename V::Scalar>& shear, const V* disp = nullptr) {
-  using T = typename V::Scalar;
-  V f[3], fStart[3], U[3];  // columns of F, of F at the start of the substep (damping) and of U
-  T B[3][3];
-  for (int i = 0; i < 3; ++i) {
-    f[i] = a[0][i] * x[0] + a[1][i] * x[1] + a[2][i] * x[2] + a[3][i] * x[3];
-    // grad C . disp = f_j.D_i + f_i.D_j with the displacement gradient D = F - F(start).
-    fStart[i] =
-        disp ? V(f[i] - (a[0][i] * disp[0] + a[1][i] * disp[1] + a[2][i] * disp[2] + a[3][i] * disp[3])) : V(V::Zero());
-    U[i] = V::Zero();
-    for (int j = i; j < 3; ++j)
-      B[i][j] = B[j][i] =
-          w[0] * a[0][i] * a[0][j] + w[1] * a[1][i] * a[1][j] + w[2] * a[2][i] * a[2][j] + w[3] * a[3][i] * a[3][j];
-  }
-
+  TetLocalSolve<V> s(x, w, a, disp);
   StrainCorrection<V> out;
-  // One component; c is a template argument so that i and j are constants and f, B and U stay in
-  // registers (a runtime loop over kStrainAxes keeps them in memory).
-  auto project = [&]<int c>() {
-    constexpr int i = kStrainAxes[c][0], j = kStrainAxes[c][1];
-    const T Sij = f[i].dot(f[j]);
-    V gi, gj;  // changes of U's columns i and j
-    if constexpr (i == j) {
-      const T gradDotDisp = disp ? T(2.0f * f[i].dot(f[i] - fStart[i])) : splat<T>(0.0);
-      out.dLambda[c] = deltaLambda(T(Sij - 1.0f), lambda[c], T(4.0f * B[i][i] * Sij), stretch, gradDotDisp);
-      gi = (2.0f * out.dLambda[c]) * f[i];
-      U[i] += gi;
-      for (int m = 0; m < 3; ++m) f[m] += B[i][m] * gi;  // F += gi B_i. (the rank-1 change of F)
-    } else {
-      const T gradMinvGrad = B[i][i] * f[j].squaredNorm() + B[j][j] * f[i].squaredNorm() + 2.0f * B[i][j] * Sij;
-      const T gradDotDisp = disp ? T(f[j].dot(f[i] - fStart[i]) + f[i].dot(f[j] - fStart[j])) : splat<T>(0.0);
-      out.dLambda[c] = deltaLambda(Sij, lambda[c], gradMinvGrad, shear, gradDotDisp);
-      gi = out.dLambda[c] * f[j];
-      gj = out.dLambda[c] * f[i];
-      U[i] += gi;
-      U[j] += gj;
-      for (int m = 0; m < 3; ++m) f[m] += B[i][m] * gi + B[j][m] * gj;  // F += gi B_i. + gj B_j.
-    }
-  };
-  [&]<int... c>(std::integer_sequence<int, c...>) { (project.template operator()<c>(), ...); }
-  (std::make_integer_sequence<int, kStrainComponents>{});
-  for (int k = 0; k < 4; ++k) out.dp[k] = w[k] * V(a[k][0] * U[0] + a[k][1] * U[1] + a[k][2] * U[2]);
+  out.dLambda = s.strain(lambda, stretch, shear);
+  s.corrections(w, a, out.dp);
   return out;
 }
 
