@@ -41,8 +41,12 @@ TEST(StrainVolume, OnePassEqualsStrainThenVolume) {
     const auto volume = XpbdCoefficients::make(0.1f * comp(rng), 0.01f * comp(rng), invH);
     const auto weights = strainWeights(Mat3(restShape.inverse()));
     const Vec3 a[4] = {weights[0], weights[1], weights[2], weights[3]};
+    Vec3 start[4], fStart[3];  // the positions at the start of the substep, and F then
+    for (int k = 0; k < 4; ++k) start[k] = x[k] - disp[k];
+    deformationColumns(start, a, fStart);
     for (const Vec3* d : {static_cast<const Vec3*>(nullptr), static_cast<const Vec3*>(disp)}) {
-      const auto fused = solveStrainVolume(x, w, a, lambda, stretch, shear, restVolume, volumeLambda, volume, d);
+      const auto fused =
+          solveStrainVolume(x, w, a, lambda, stretch, shear, restVolume, volumeLambda, volume, d ? fStart : nullptr);
       // The separate kernels: the volume projection sees the particles, and their motion in the
       // substep, after the strain projection.
       const auto s = solveStrain(x, w, a, lambda, stretch, shear, d);

@@ -131,12 +131,12 @@ T loadLanes(const float* f, std::size_t count = kWidth<T>) {
   return v;
 }
 template <typename T>
+void storeLanes(float* f, T v, std::size_t count = kWidth<T>) {
+  std::memcpy(f, &v, (count == kWidth<T> ? kWidth<T> : count) * sizeof(float));
+}
+template <typename T>
 void addLanes(float* f, T delta, std::size_t count = kWidth<T>) {
-  const T v = loadLanes<T>(f, count) + delta;
-  if (count == kWidth<T>)
-    std::memcpy(f, &v, sizeof(T));
-  else
-    std::memcpy(f, &v, count * sizeof(float));
+  storeLanes<T>(f, loadLanes<T>(f, count) + delta, count);
 }
 
 }  // namespace vrd::sweeps

@@ -22,6 +22,9 @@ struct LaneSweeps {
   /// lambda: StrainLambdas::data() of `tets` tets
   void (*strain)(const StrainConstraint* c, std::size_t begin, std::size_t end, float* lambda, std::size_t tets,
                  const ConstraintDamping& damping, bool damped, const Range& r);
+  /// F of `tets` tets at the start of the substep into `out` (Body::startDeformation)
+  void (*startDeformation)(const StrainConstraint* c, std::size_t begin, std::size_t end, float* out, std::size_t tets,
+                           const Range& r);
   /// strain and volume of the same `tets` tets in one pass (strain_volume.h)
   void (*strainVolume)(const StrainConstraint* strain, const VolumeConstraint* volume, std::size_t begin,
                        std::size_t end, float* strainLambda, float* volumeLambda, std::size_t tets,
@@ -44,6 +47,9 @@ LaneSweeps makeLaneSweeps() {
          const ConstraintDamping& damping, bool damped, const Range& r) {
         damped ? strain<T, true>(c, begin, end, lambda, tets, damping, r)
                : strain<T, false>(c, begin, end, lambda, tets, damping, r);
+      },
+      [](const StrainConstraint* c, std::size_t begin, std::size_t end, float* out, std::size_t tets, const Range& r) {
+        startDeformation<T>(c, begin, end, out, tets, r);
       },
       [](const StrainConstraint* s, const VolumeConstraint* v, std::size_t begin, std::size_t end, float* strainLambda,
          float* volumeLambda, std::size_t tets, const ConstraintDamping& damping, bool damped, const Range& r) {

@@ -75,10 +75,26 @@ struct Gathered {
 
 // Everything a sweep needs about the body it runs over.
 struct Range {
-  Point* pred;         // the body's predicted positions
-  const Point* start;  // and its positions at the start of the substep
-  float invH;          // 1/h
+  Point* pred;                    // the body's predicted positions
+  const Point* start;             // and its positions at the start of the substep
+  float invH;                     // 1/h
+  const float* startDeformation;  // Body::startDeformation (damped strain sweeps)
 };
+
+// Column i's coordinate d of tet j's F is at deformation[(3 i + d) * tets + j] (Body::startDeformation).
+template <typename T>
+void loadDeformation(const float* deformation, std::size_t tets, std::size_t first, std::size_t count,
+                     VecOf<T> (&f)[3]) {
+  for (std::size_t i = 0; i < 3; ++i) {
+    const float* column = deformation + 3 * i * tets + first;
+    const T x = loadLanes<T>(column, count), y = loadLanes<T>(column + tets, count),
+            z = loadLanes<T>(column + 2 * tets, count);
+    if constexpr (kWidth<T> == 1)
+      f[i] = Vec3(x, y, z);
+    else
+      f[i] = {x, y, z};
+  }
+}
 
 /// Calls batch(i, count, c...) for constraints [begin, end) of one or more arrays of the same order,
 /// kWidth<T> at a time from c = constraints + i (count = kWidth<T>); the last (end - begin) %
@@ -159,22 +175,24 @@ void strainWeightsOf(const StrainConstraint* c, VecOf<T> (&a)[4]) {
   }
 }
 
-// The lanes of a strain batch: weights, the two coefficients and the six multipliers (component k of
-// tet j at lambdas[k * tets + j], StrainLambdas).
+// The lanes of a strain batch: weights, the two coefficients, the six multipliers (component k of
+// tet j at lambdas[k * tets + j], StrainLambdas) and, when damped, F at the start of the substep.
 template <typename T>
 struct StrainLanes {
   VecOf<T> a[4];
   XpbdCoefficientsT<T> stretch, shear;
   StrainLambdaT<T> lambda;
+  VecOf<T> fStart[3];
 
   StrainLanes(const StrainConstraint* c, const float* lambdas, std::size_t tets, std::size_t first, std::size_t count,
-              const ConstraintDamping& damping, float invH)
+              const ConstraintDamping& damping, float invH, const float* startDeformation)
       : stretch(XpbdCoefficientsT<T>::make(fieldOf<T>(c, &StrainConstraint::stretchCompliance),
                                            splat<T>(damping.strainStretch), invH)),
         shear(XpbdCoefficientsT<T>::make(fieldOf<T>(c, &StrainConstraint::shearCompliance),
                                          splat<T>(damping.strainShear), invH)) {
     strainWeightsOf<T>(c, a);
     for (int k = 0; k < kStrainComponents; ++k) lambda[k] = loadLanes<T>(lambdas + k * tets + first, count);
+    if (startDeformation) loadDeformation<T>(startDeformation, tets, first, count, fStart);
   }
   static void add(float* lambdas, std::size_t tets, std::size_t first, std::size_t count,
                   const StrainLambdaT<T>& dLambda) {
@@ -182,13 +200,32 @@ struct StrainLanes {
   }
 };
 
+// F of tets [begin, end) at the start of the substep, into Body::startDeformation (`out`): the damped
+// strain sweeps read it instead of the positions then.
+template <typename T>
+[[gnu::flatten]] void startDeformation(const StrainConstraint* constraints, std::size_t begin, std::size_t end,
+                                       float* out, std::size_t tets, const Range& r) {
+  const auto batch = [&](std::size_t first, std::size_t count, const StrainConstraint* c) {
+    const Gathered<T, 4, false> g(c, count, r.start, r.start);
+    VecOf<T> a[4], f[3];
+    strainWeightsOf<T>(c, a);
+    deformationColumns(g.x, a, f);
+    for (int i = 0; i < 3; ++i)
+      for (int d = 0; d < 3; ++d) storeLanes<T>(out + std::size_t(3 * i + d) * tets + first, f[i][d], count);
+  };
+  forBatches<T>(begin, end, batch, constraints);
+}
+
 template <typename T, bool Damped>
 [[gnu::flatten]] void strain(const StrainConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
                              std::size_t tets, const ConstraintDamping& damping, const Range& r) {
   const auto batch = [&](std::size_t first, std::size_t count, const StrainConstraint* c) {
-    Gathered<T, 4, Damped> g(c, count, r.pred, r.start);
-    const StrainLanes<T> s(c, lambdas, tets, first, count, damping, r.invH);
-    const auto out = solveStrain(g.x, g.w, s.a, s.lambda, s.stretch, s.shear, g.displacement());
+    Gathered<T, 4, false> g(c, count, r.pred, r.start);
+    const StrainLanes<T> s(c, lambdas, tets, first, count, damping, r.invH, Damped ? r.startDeformation : nullptr);
+    TetLocalSolve<VecOf<T>> solve(g.x, g.w, s.a, Damped ? s.fStart : nullptr);
+    StrainCorrection<VecOf<T>> out;
+    out.dLambda = solve.strain(s.lambda, s.stretch, s.shear);
+    solve.corrections(g.w, s.a, out.dp);
     StrainLanes<T>::add(lambdas, tets, first, count, out.dLambda);
     g.move(out.dp);
     g.store(r.pred);
@@ -202,13 +239,14 @@ template <typename T, bool Damped>
                                    std::size_t end, float* strainLambdas, float* volumeLambdas, std::size_t tets,
                                    const ConstraintDamping& damping, const Range& r) {
   const auto batch = [&](std::size_t first, std::size_t count, const StrainConstraint* c, const VolumeConstraint* v) {
-    Gathered<T, 4, Damped> g(c, count, r.pred, r.start);
-    const StrainLanes<T> s(c, strainLambdas, tets, first, count, damping, r.invH);
+    Gathered<T, 4, false> g(c, count, r.pred, r.start);
+    const StrainLanes<T> s(c, strainLambdas, tets, first, count, damping, r.invH,
+                           Damped ? r.startDeformation : nullptr);
     const auto k =
         XpbdCoefficientsT<T>::make(fieldOf<T>(v, &VolumeConstraint::compliance), splat<T>(damping.volume), r.invH);
     const auto out =
         solveStrainVolume(g.x, g.w, s.a, s.lambda, s.stretch, s.shear, fieldOf<T>(v, &VolumeConstraint::restVolume),
-                          loadLanes<T>(volumeLambdas + first, count), k, g.displacement());
+                          loadLanes<T>(volumeLambdas + first, count), k, Damped ? s.fStart : nullptr);
     StrainLanes<T>::add(strainLambdas, tets, first, count, out.dLambdaStrain);
     addLanes<T>(volumeLambdas + first, out.dLambdaVolume, count);
     g.move(out.dp);

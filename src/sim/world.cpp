@@ -65,6 +65,9 @@ BodyId World::addBody(std::shared_ptr<const BodyModel> model, const Vec3& transl
   body.volumeLambda.assign(model->volume.size(), 0.0f);
   body.strainLambda.assign(model->strain.size());
   body.bendLambda.assign(model->bend.size(), 0.0f);
+  const ConstraintDamping& tau = model->damping;
+  if (!model->strain.empty() && (tau.strainStretch > 0.0f || tau.strainShear > 0.0f || tau.volume > 0.0f))
+    body.startDeformation.assign(9 * model->strain.size(), 0.0f);
   body.shapeMatchLambda.assign(model->shapeMatching ? model->particleCount() : 0, Vec3::Zero());
   body.shapeMatchRotation = rotation.cast<double>();
   for (std::size_t i = 0; i < model->particleCount(); ++i) {
@@ -318,11 +321,27 @@ void World::solveIterations(float h) {
 #pragma omp parallel num_threads(settings_.threads)
     {
       const SolverTeam team = SolverTeam::current();
+      startDeformations(plan, team);
       for (int it = 0; it < settings_.iterations; ++it) solveIteration(h, plan, team);
     }
   } else {
+    startDeformations(plan, SolverTeam{});
     for (int it = 0; it < settings_.iterations; ++it) solveIteration(h, plan, SolverTeam{});
   }
+}
+
+// F of every tet at the start of the substep, for the damped strain sweeps: each member a share.
+void World::startDeformations(const sweeps::LanePlan& plan, const SolverTeam& team) {
+  for (Body& b : bodies_) {
+    if (b.state != BodyState::Active || b.startDeformation.empty()) continue;
+    const BodyModel& m = *b.model;
+    const sweeps::Range r{nullptr, particles_.x.data() + b.firstParticle, 0.0f, nullptr};
+    const auto [begin, end] = team.share(0, m.strain.size(), 16);
+    plan.run(begin, end, [&](const sweeps::LaneSweeps& s, std::size_t first, std::size_t last) {
+      s.startDeformation(m.strain.data(), first, last, b.startDeformation.data(), m.strain.size(), r);
+    });
+  }
+  team.barrier();
 }
 
 namespace {
@@ -393,7 +412,8 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
     if (b.state != BodyState::Active) continue;
     const BodyModel& m = *b.model;
     const ConstraintDamping& tau = m.damping;
-    const sweeps::Range r{pred + b.firstParticle, start + b.firstParticle, invH};
+    const sweeps::Range r{pred + b.firstParticle, start + b.firstParticle, invH,
+                          b.startDeformation.empty() ? nullptr : b.startDeformation.data()};
     if (!m.distance.empty()) {
       StageTimer t(times, Stage::Distance, timed);
       const bool damped = tau.distance > 0.0f;
@@ -564,7 +584,8 @@ std::size_t World::bodyBytes(BodyId id) const {
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   const std::size_t perParticle = 2 * sizeof(Point) + 2 * sizeof(Vec3);  // x, p, v, force
   return b.model->bytes() + bytes(b.distanceLambda) + bytes(b.volumeLambda) + b.strainLambda.bytes() +
-         bytes(b.bendLambda) + bytes(b.shapeMatchLambda) + bytes(b.initialPositions) + b.particleCount * perParticle;
+         bytes(b.bendLambda) + bytes(b.startDeformation) + bytes(b.shapeMatchLambda) + bytes(b.initialPositions) +
+         b.particleCount * perParticle;
 }
 
 double World::volumeLoss(BodyId id) const {

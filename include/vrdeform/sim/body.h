@@ -31,6 +31,10 @@ struct Body {
   StrainLambdas strainLambda;
   std::vector<float> bendLambda;
   std::vector<Vec3> shapeMatchLambda;
+  /// F of each tet at the start of the substep, for the damping of its strain and volume
+  /// constraints: coordinate d of column i of tet j at [(3 i + d) * tets + j]. Empty when the body
+  /// has no strain constraints or they are undamped.
+  std::vector<float> startDeformation;
   Eigen::Quaterniond shapeMatchRotation = Eigen::Quaterniond::Identity();  ///< R of the last shape match (warm start)
 
   std::vector<Vec3> initialPositions;  ///< world positions at creation; resetBody() returns them at rest

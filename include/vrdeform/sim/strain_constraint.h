@@ -96,6 +96,12 @@ struct StrainCorrection {
   V dp[4];
 };
 
+/// Eq. 31 through the strain weights: F's columns f_i = sum_k a_k[i] x_k.
+template <typename V>
+void deformationColumns(const V (&x)[4], const V (&a)[4], V (&f)[3]) {
+  for (int i = 0; i < 3; ++i) f[i] = a[0][i] * x[0] + a[1][i] * x[1] + a[2][i] * x[2] + a[3][i] * x[3];
+}
+
 /// The closed-form local solve of one tet's strain constraints (see solveStrain), kept as state so
 /// that further constraints on the same tet can follow it in the same pass (strain_volume.h):
 /// F's columns f (kept current as corrections are made), F at the start of the substep (damping),
@@ -107,13 +113,11 @@ struct TetLocalSolve {
   T B[3][3];
   bool damped;
 
-  /// `disp`: each particle's motion since the start of the substep; null when undamped.
-  TetLocalSolve(const V (&x)[4], const T (&w)[4], const V (&a)[4], const V* disp) : damped(disp != nullptr) {
+  /// `fStart`: F's columns at the start of the substep (damping); null when undamped.
+  TetLocalSolve(const V (&x)[4], const T (&w)[4], const V (&a)[4], const V* fStart) : damped(fStart != nullptr) {
+    deformationColumns(x, a, f);
     for (int i = 0; i < 3; ++i) {
-      f[i] = a[0][i] * x[0] + a[1][i] * x[1] + a[2][i] * x[2] + a[3][i] * x[3];
-      // The displacement gradient is F - F(start) = sum_k disp_k a_k^T.
-      fStart[i] = disp ? V(f[i] - (a[0][i] * disp[0] + a[1][i] * disp[1] + a[2][i] * disp[2] + a[3][i] * disp[3]))
-                       : V(V::Zero());
+      this->fStart[i] = fStart ? fStart[i] : V(V::Zero());
       U[i] = V::Zero();
       for (int j = i; j < 3; ++j)
         B[i][j] = B[j][i] =
@@ -176,7 +180,13 @@ StrainCorrection<V> solveStrain(const V (&x)[4], const typename V::Scalar (&w)[4
                                 const StrainLambdaT<typename V::Scalar>& lambda,
                                 const XpbdCoefficientsT<typename V::Scalar>& stretch,
                                 const XpbdCoefficientsT<typename V::Scalar>& shear, const V* disp = nullptr) {
-  TetLocalSolve<V> s(x, w, a, disp);
+  V fStart[3];
+  if (disp) {
+    V start[4];
+    for (int k = 0; k < 4; ++k) start[k] = x[k] - disp[k];
+    deformationColumns(start, a, fStart);
+  }
+  TetLocalSolve<V> s(x, w, a, disp ? fStart : nullptr);
   StrainCorrection<V> out;
   out.dLambda = s.strain(lambda, stretch, shear);
   s.corrections(w, a, out.dp);

@@ -45,7 +45,8 @@ typename V::Scalar projectVolume(TetLocalSolve<V>& s, const V (&a)[4], typename 
 }
 
 /// solveStrain, then solveVolume on the moved particles, in one: equal to the two one after the
-/// other up to rounding. `disp` as for solveStrain.
+/// other up to rounding. `fStart`: F's columns at the start of the substep (deformationColumns of
+/// the positions then), for damping; null when undamped.
 template <typename V>
 StrainVolumeCorrection<V> solveStrainVolume(const V (&x)[4], const typename V::Scalar (&w)[4], const V (&a)[4],
                                             const StrainLambdaT<typename V::Scalar>& strainLambda,
@@ -53,8 +54,8 @@ StrainVolumeCorrection<V> solveStrainVolume(const V (&x)[4], const typename V::S
                                             const XpbdCoefficientsT<typename V::Scalar>& shear,
                                             typename V::Scalar restVolume, typename V::Scalar volumeLambda,
                                             const XpbdCoefficientsT<typename V::Scalar>& volume,
-                                            const V* disp = nullptr) {
-  TetLocalSolve<V> s(x, w, a, disp);
+                                            const V* fStart = nullptr) {
+  TetLocalSolve<V> s(x, w, a, fStart);
   StrainVolumeCorrection<V> out;
   out.dLambdaStrain = s.strain(strainLambda, stretch, shear);
   out.dLambdaVolume = projectVolume(s, a, restVolume, volumeLambda, volume);

@@ -147,6 +147,7 @@ class World {
   void detectTriangleContacts();
   void resetMultipliers();
   void solveIterations(float h);
+  void startDeformations(const sweeps::LanePlan& plan, const SolverTeam& team);
   void solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team);
   void solveWorldConstraints(float invH, bool timed);
   void finalise(float h);
