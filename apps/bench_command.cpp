@@ -228,6 +228,7 @@ json scaling(const BenchArgs& a, std::string& text) {
       for (int threads = 1; threads <= 2; ++threads) {
         SolverSettings s;
         s.simd = simd ? SimdLevel::Best : SimdLevel::Off;
+        s.fuseStrainVolume = simd;  // scalar: the paper's order, the baseline
         s.threads = threads;
         s.timeStages = false;
         Block b = block(mesh, softMaterial(), ConstraintSet::paper(), s);
