@@ -184,15 +184,22 @@ TEST(Lanes, VolumeAndStrainKernelsMatchScalar) {
 
 // A soft block pinned at one side sagging for a second, with damping on (the displacement terms).
 // (Not dropped on the ground: a particle just in or out of contact turns rounding into millimetres.)
-std::vector<Vec3> sagBlock(const std::shared_ptr<const BodyModel>& model, const SolverSettings& s, int steps = 60) {
+// Several models: as many bodies in one world (they do not touch each other), their particles in order.
+std::vector<Vec3> sagBlocks(const std::vector<std::shared_ptr<const BodyModel>>& models, const SolverSettings& s,
+                            int steps = 60) {
   World w(s);
-  const BodyId b = w.addBody(model);
-  for (Index i = 0; i < model->particleCount(); ++i)
-    if (model->restPositions[i].x() < -0.0499f) w.setInverseMass(w.particleIndex(b, i), 0.0f);
+  for (const auto& model : models) {
+    const BodyId b = w.addBody(model);
+    for (Index i = 0; i < model->particleCount(); ++i)
+      if (model->restPositions[i].x() < -0.0499f) w.setInverseMass(w.particleIndex(b, i), 0.0f);
+  }
   for (int step = 0; step < steps; ++step) w.step();
   std::vector<Vec3> x;
-  for (Index i = 0; i < model->particleCount(); ++i) x.push_back(w.particles().x[w.particleIndex(b, i)].pos);
+  for (const Point& p : w.particles().x) x.push_back(p.pos);
   return x;
+}
+std::vector<Vec3> sagBlock(const std::shared_ptr<const BodyModel>& model, const SolverSettings& s, int steps = 60) {
+  return sagBlocks({model}, s, steps);
 }
 
 std::shared_ptr<const BodyModel> dampedBlock(int cells, const ConstraintSet& set,
@@ -227,22 +234,25 @@ TEST(Lanes, EveryWidthAgreesWithTheReferenceLoops) {
 }
 
 // Two threads sweep a big body's groups two at a time, three share each colour, and a small body
-// is swept by one of them; either way constraints run at once only when they touch disjoint
-// particles, so the result is bit for bit the one-thread result.
+// in the same world is swept by one of them (alone, a small body runs on one thread); either way
+// constraints run at once only when they touch disjoint particles, so the result is bit for bit
+// the one-thread result.
 TEST(Lanes, ThreadsGiveTheOneThreadResultExactly) {
 #if defined(__SANITIZE_THREAD__)
   GTEST_SKIP() << "libgomp is not built for ThreadSanitizer; its barriers would be reported as races";
 #endif
-  for (int cells : {4, 10}) {  // 384 tets: not cut; 6,000: in groups
-    const auto model = dampedBlock(cells, {true, true, true, true});
-    ASSERT_EQ(model->tetGroups.size(), cells == 4 ? 0u : 6u);
+  const auto small = dampedBlock(4, {true, true, true, true});  // 384 tets: not cut
+  const auto big = dampedBlock(10, {true, true, true, true});   // 6,000: in groups
+  ASSERT_EQ(small->tetGroups.size(), 0u);
+  ASSERT_EQ(big->tetGroups.size(), 6u);
+  for (const auto& models : {std::vector{small}, std::vector{big}, std::vector{big, small}}) {
     SolverSettings s;
-    const std::vector<Vec3> one = sagBlock(model, s, 5);
+    const std::vector<Vec3> one = sagBlocks(models, s, 5);
     for (int threads : {2, 3}) {
       s.threads = threads;  // (on a busy machine a barrier may wait for a descheduled thread: few steps)
-      const std::vector<Vec3> many = sagBlock(model, s, 5);
-      for (Index i = 0; i < model->particleCount(); ++i)
-        ASSERT_EQ(many[i], one[i]) << cells << " cells, " << threads << " threads, particle " << i;
+      const std::vector<Vec3> many = sagBlocks(models, s, 5);
+      for (std::size_t i = 0; i < one.size(); ++i)
+        ASSERT_EQ(many[i], one[i]) << models.size() << " bodies, " << threads << " threads, particle " << i;
     }
   }
 }

@@ -317,7 +317,12 @@ void World::resetMultipliers() {
 
 void World::solveIterations(float h) {
   const sweeps::LanePlan plan = sweeps::lanePlan(settings_.simd);
-  if (settings_.threads > 1) {
+  // A team pays only for a body big enough to be cut in groups (body_model.cpp): a smaller array is
+  // swept by one member anyway, and the others would only wait at its barriers.
+  const bool cut = std::any_of(bodies_.begin(), bodies_.end(), [](const Body& b) {
+    return b.state == BodyState::Active && !(b.model->tetGroups.empty() && b.model->distanceGroups.empty());
+  });
+  if (settings_.threads > 1 && cut) {
 #pragma omp parallel num_threads(settings_.threads)
     {
       const SolverTeam team = SolverTeam::current();

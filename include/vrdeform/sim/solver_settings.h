@@ -41,8 +41,8 @@ struct SolverSettings {
   /// Lanes for each colour's constraints: the same Gauss-Seidel sweep as Off, up to rounding.
   SimdLevel simd = SimdLevel::Best;
   /// Solver threads (OpenMP): 2 sweep the halves of a big body at once, more share each colour;
-  /// the result does not depend on it. Worth it for bodies of several thousand tets; 1 runs on the
-  /// calling thread alone.
+  /// the result does not depend on it. Worth it for bodies of several thousand tets: a world with
+  /// no body of 4,096 or more constraints of one type runs on the calling thread alone, as does 1.
   int threads = 1;
   /// Projects a tet's strain and volume constraints together, in one pass over the tets
   /// (strain_volume.h), instead of all strain constraints and then all volume ones as the paper
