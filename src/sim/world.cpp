@@ -65,6 +65,11 @@ BodyId World::addBody(std::shared_ptr<const BodyModel> model, const Vec3& transl
   body.volumeLambda.assign(model->volume.size(), 0.0f);
   body.strainLambda.assign(model->strain.size());
   body.bendLambda.assign(model->bend.size(), 0.0f);
+  body.tetsPaired = !model->strain.empty() && model->strain.size() == model->volume.size() &&
+                    std::equal(model->strain.begin(), model->strain.end(), model->volume.begin(),
+                               [](const StrainConstraint& s, const VolumeConstraint& v) {
+                                 return std::equal(std::begin(s.i), std::end(s.i), std::begin(v.i));
+                               });
   const ConstraintDamping& tau = model->damping;
   if (!model->strain.empty() && (tau.strainStretch > 0.0f || tau.strainShear > 0.0f || tau.volume > 0.0f))
     body.startDeformation.assign(9 * model->strain.size(), 0.0f);
@@ -429,7 +434,7 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
     }
     // Strain before volume: S = F^T F cannot tell a tet from its mirror image, so the signed
     // volume constraint gets the last word on orientation.
-    if (settings_.fuseStrainVolume && !m.strain.empty() && !m.volume.empty()) {
+    if (settings_.fuseStrainVolume && b.tetsPaired) {
       StageTimer t(times, Stage::StrainVolume, timed);
       const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f || tau.volume > 0.0f;
       sweepColours(m.tetColours, m.tetGroups, m.strain.size(), plan, team,

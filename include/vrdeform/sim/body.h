@@ -35,6 +35,9 @@ struct Body {
   /// constraints: coordinate d of column i of tet j at [(3 i + d) * tets + j]. Empty when the body
   /// has no strain constraints or they are undamped.
   std::vector<float> startDeformation;
+  /// strain[j] and volume[j] of the model are on the same tet for every j, so that one pass can
+  /// project both (SolverSettings::fuseStrainVolume); a hand-built model need not pair them.
+  bool tetsPaired = false;
   Eigen::Quaterniond shapeMatchRotation = Eigen::Quaterniond::Identity();  ///< R of the last shape match (warm start)
 
   std::vector<Vec3> initialPositions;  ///< world positions at creation; resetBody() returns them at rest
