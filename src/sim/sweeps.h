@@ -222,10 +222,7 @@ template <typename T, bool Damped>
   const auto batch = [&](std::size_t first, std::size_t count, const StrainConstraint* c) {
     Gathered<T, 4, false> g(c, count, r.pred, r.start);
     const StrainLanes<T> s(c, lambdas, tets, first, count, damping, r.invH, Damped ? r.startDeformation : nullptr);
-    TetLocalSolve<VecOf<T>> solve(g.x, g.w, s.a, Damped ? s.fStart : nullptr);
-    StrainCorrection<VecOf<T>> out;
-    out.dLambda = solve.strain(s.lambda, s.stretch, s.shear);
-    solve.corrections(g.w, s.a, out.dp);
+    const auto out = solveStrainFromStart(g.x, g.w, s.a, s.lambda, s.stretch, s.shear, Damped ? s.fStart : nullptr);
     StrainLanes<T>::add(lambdas, tets, first, count, out.dLambda);
     g.move(out.dp);
     g.store(r.pred);

@@ -167,6 +167,20 @@ struct TetLocalSolve {
   }
 };
 
+/// solveStrain given F's columns at the start of the substep (deformationColumns of the positions
+/// then; null when undamped) instead of the particles' motion since.
+template <typename V>
+StrainCorrection<V> solveStrainFromStart(const V (&x)[4], const typename V::Scalar (&w)[4], const V (&a)[4],
+                                         const StrainLambdaT<typename V::Scalar>& lambda,
+                                         const XpbdCoefficientsT<typename V::Scalar>& stretch,
+                                         const XpbdCoefficientsT<typename V::Scalar>& shear, const V* fStart) {
+  TetLocalSolve<V> s(x, w, a, fStart);
+  StrainCorrection<V> out;
+  out.dLambda = s.strain(lambda, stretch, shear);
+  s.corrections(w, a, out.dp);
+  return out;
+}
+
 /// One local Gauss-Seidel sweep over the six strain constraints of a tet, for particles x with
 /// inverse masses w and strain weights a (see strainWeights).
 ///
@@ -186,11 +200,7 @@ StrainCorrection<V> solveStrain(const V (&x)[4], const typename V::Scalar (&w)[4
     for (int k = 0; k < 4; ++k) start[k] = x[k] - disp[k];
     deformationColumns(start, a, fStart);
   }
-  TetLocalSolve<V> s(x, w, a, disp ? fStart : nullptr);
-  StrainCorrection<V> out;
-  out.dLambda = s.strain(lambda, stretch, shear);
-  s.corrections(w, a, out.dp);
-  return out;
+  return solveStrainFromStart(x, w, a, lambda, stretch, shear, disp ? fStart : nullptr);
 }
 
 /// The straightforward form of solveStrain: project each component with eq. 1 and eq. 3,
