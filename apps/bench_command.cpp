@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -350,9 +351,26 @@ json targets(const BenchArgs& a, const json& table1Rows, std::string& text) {
   return out;
 }
 
+// The machine the figures come from: they differ by 2x between CPUs of the same kind (with and
+// without AVX-512, say), so a table means little without it.
+json machine() {
+  std::string cpu = "unknown CPU";
+  std::ifstream info("/proc/cpuinfo");
+  for (std::string line; std::getline(info, line);)
+    if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos) {
+      cpu = line.substr(line.find(':') + 1);
+      cpu.erase(0, cpu.find_first_not_of(' '));
+      break;
+    }
+  return {{"cpu", cpu},
+          {"hardware_threads", std::thread::hardware_concurrency()},
+          {"lanes", simdName(resolveSimd(SimdLevel::Best))}};
+}
+
 int bench(const BenchArgs& a) {
   std::string text;
   json j;
+  j["machine"] = machine();
   j["frames"] = a.frames;
   j["table1"] = table1(a, text);
   j["table2"] = table2(a, text);
@@ -363,8 +381,11 @@ int bench(const BenchArgs& a) {
   if (a.json)
     fmt::print("{}\n", j.dump(2));
   else
-    fmt::print("{}The paper: Unity/C# on an i7-13700K. Here: this machine, one thread unless a row says otherwise.\n",
-               text);
+    fmt::print(
+        "{}The paper: Unity/C# on an i7-13700K. Here: {} ({} hardware threads, {} lanes), one thread unless a row says "
+        "otherwise.\n",
+        text, j["machine"]["cpu"].get<std::string>(), j["machine"]["hardware_threads"].get<unsigned>(),
+        j["machine"]["lanes"].get<std::string>());
   return 0;
 }
 
