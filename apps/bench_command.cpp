@@ -353,24 +353,27 @@ json targets(const BenchArgs& a, const json& table1Rows, std::string& text) {
 
 // The machine the figures come from: they differ by 2x between CPUs of the same kind (with and
 // without AVX-512, say), so a table means little without it.
-json machine() {
-  std::string cpu = "unknown CPU";
-  std::ifstream info("/proc/cpuinfo");
-  for (std::string line; std::getline(info, line);)
-    if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos) {
-      cpu = line.substr(line.find(':') + 1);
-      cpu.erase(0, cpu.find_first_not_of(' '));
-      break;
-    }
-  return {{"cpu", cpu},
-          {"hardware_threads", std::thread::hardware_concurrency()},
-          {"lanes", simdName(resolveSimd(SimdLevel::Best))}};
-}
+struct Machine {
+  std::string cpu = "unknown CPU";  // /proc/cpuinfo's model name
+  unsigned threads = std::thread::hardware_concurrency();
+  std::string lanes = simdName(resolveSimd(SimdLevel::Best));
+
+  Machine() {
+    std::ifstream info("/proc/cpuinfo");
+    for (std::string line; std::getline(info, line);)
+      if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos) {
+        cpu = line.substr(line.find(':') + 1);
+        cpu.erase(0, cpu.find_first_not_of(' '));
+        return;
+      }
+  }
+};
 
 int bench(const BenchArgs& a) {
   std::string text;
   json j;
-  j["machine"] = machine();
+  const Machine m;
+  j["machine"] = {{"cpu", m.cpu}, {"hardware_threads", m.threads}, {"lanes", m.lanes}};
   j["frames"] = a.frames;
   j["table1"] = table1(a, text);
   j["table2"] = table2(a, text);
@@ -384,8 +387,7 @@ int bench(const BenchArgs& a) {
     fmt::print(
         "{}The paper: Unity/C# on an i7-13700K. Here: {} ({} hardware threads, {} lanes), one thread unless a row says "
         "otherwise.\n",
-        text, j["machine"]["cpu"].get<std::string>(), j["machine"]["hardware_threads"].get<unsigned>(),
-        j["machine"]["lanes"].get<std::string>());
+        text, m.cpu, m.threads, m.lanes);
   return 0;
 }
 
