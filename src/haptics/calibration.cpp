@@ -20,15 +20,16 @@ Vec3 centroid(const World& world, BodyId id) {
 
 // Inverse-distance-weighted mean of |lambda^V| and ||lambda^S|| around `centre` (eq. 43's weights).
 std::pair<double, double> weightedMultipliers(const World& world, BodyId id, const Vec3& centre, float epsilon,
-                                              std::vector<Vec3>& centroids) {
+                                              TetSignals& tets) {
   const Body& b = world.body(id);
   const Point* x = world.particles().x.data() + b.firstParticle;
   double v = 0.0, s = 0.0, weights = 0.0;
-  centroids.clear();
+  tets.resize(b.model->tets.size());
   for (std::size_t j = 0; j < b.model->tets.size(); ++j) {
     const Tet& t = b.model->tets[j];
-    centroids.push_back(0.25f * (x[t[0]].pos + x[t[1]].pos + x[t[2]].pos + x[t[3]].pos));
-    const double w = 1.0 / ((centroids.back() - centre).norm() + epsilon);
+    const Vec3 centroid = 0.25f * (x[t[0]].pos + x[t[1]].pos + x[t[2]].pos + x[t[3]].pos);
+    tets.setCentroid(j, centroid);
+    const double w = 1.0 / ((centroid - centre).norm() + epsilon);
     if (j < b.volumeLambda.size()) v += w * std::abs(b.volumeLambda[j]);
     if (j < b.strainLambda.size()) {
       float sq = 0.0f;
@@ -94,20 +95,17 @@ HapticCalibration calibrateHaptics(const World& original, BodyId body, const Hap
   out.signal.tauContact = world.fingertipLambdaSum(tip) / float(count) / settings.contactTarget;
   out.signal.tauFingerContact = world.fingertipLambdaSum(tip) / settings.contactTarget;
 
-  std::vector<Vec3> centroids;
-  const auto [volume, strain] = weightedMultipliers(world, body, world.fingertip(tip).center, base.epsilon, centroids);
+  TetSignals tets;
+  const auto [volume, strain] = weightedMultipliers(world, body, world.fingertip(tip).center, base.epsilon, tets);
   if (volume > 0.0 || strain > 0.0) {
     // F_VS falls as the tau grow together; bisect the common scale (in log space) to the target.
-    std::vector<float> signals(centroids.size());
     const Body& poked = world.body(body);
     auto signalAt = [&](double scale) {
       HapticSignalSettings s = base;
       s.tauVolume = volume > 0.0 ? float(scale * volume) : base.tauVolume;
       s.tauStrain = strain > 0.0 ? float(scale * strain) : base.tauStrain;
-      for (std::size_t j = 0; j < centroids.size(); ++j)
-        signals[j] = tetSignal(j < poked.volumeLambda.size() ? poked.volumeLambda[j] : 0.0f,
-                               j < poked.strainLambda.size() ? poked.strainLambda[j] : StrainLambda{}, s);
-      return std::pair{s, volumeStrainSignal(centroids, signals, world.fingertip(tip).center, base.epsilon)};
+      tetSignals(poked.volumeLambda, poked.strainLambda.values(), s, tets.f);
+      return std::pair{s, volumeStrainSignal(tets, world.fingertip(tip).center, base.epsilon)};
     };
     double lo = std::log(1e-6), hi = std::log(1e6);
     for (int it = 0; it < 80; ++it) {

@@ -49,25 +49,27 @@ HapticModel::HapticModel(const HapticSettings& settings) : settings_(settings) {
 
 void HapticModel::gatherTets(const World& world) {
   // Algorithm 2, lines 25-31: the tet centroids c_j and signals f_j (eqs. 41-42), once per step.
-  centroids_.clear();
-  tetSignal_.clear();
+  std::size_t count = 0;
+  for (BodyId id = 0; id < world.bodyCount(); ++id)
+    if (world.body(id).state == BodyState::Active) count += world.body(id).model->tets.size();
+  tets_.resize(count);
+  std::size_t first = 0;
   for (BodyId id = 0; id < world.bodyCount(); ++id) {
     const Body& b = world.body(id);
     if (b.state != BodyState::Active) continue;
     const Point* x = world.particles().x.data() + b.firstParticle;
-    const std::size_t tets = b.model->tets.size();
-    static const StrainLambda kNoStrain{};
-    for (std::size_t j = 0; j < tets; ++j) {
+    const std::size_t n = b.model->tets.size();
+    for (std::size_t j = 0; j < n; ++j) {
       const Tet& t = b.model->tets[j];
-      centroids_.push_back(0.25f * (x[t[0]].pos + x[t[1]].pos + x[t[2]].pos + x[t[3]].pos));
-      tetSignal_.push_back(tetSignal(j < b.volumeLambda.size() ? b.volumeLambda[j] : 0.0f,
-                                     j < b.strainLambda.size() ? b.strainLambda[j] : kNoStrain, settings_.signal));
+      tets_.setCentroid(first + j, 0.25f * (x[t[0]].pos + x[t[1]].pos + x[t[2]].pos + x[t[3]].pos));
     }
+    tetSignals(b.volumeLambda, b.strainLambda.values(), settings_.signal, std::span(tets_.f).subspan(first, n));
+    first += n;
   }
 }
 
 float HapticModel::inverseDistanceSignal(const Vec3& centre) const {
-  return volumeStrainSignal(centroids_, tetSignal_, centre, settings_.signal.epsilon);
+  return volumeStrainSignal(tets_, centre, settings_.signal.epsilon);
 }
 
 const HapticFrame& HapticModel::update(const World& world, const HandRig& rig, const Grasp& grasp) {

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+
+#include "vrdeform/math/lanes.h"
 
 namespace vrd {
 
@@ -12,20 +15,80 @@ float normalisedContact(float lambdaSum, std::size_t contactCount, float tauCont
   return clampUnit(std::abs(lambdaSum) / (float(contactCount) * tauContact));
 }
 
+namespace {
+
+// Eqs. 41-42 given |lambda^S|^2, for one tet (T = float) or four (Lane4). Both clips map NaN to 0.
+template <typename T>
+T signalOf(T volumeLambda, T strainSq, const HapticSignalSettings& s) {
+  const T zero = splat<T>(0.0), one = splat<T>(1.0);
+  const auto clip = [&](T v) { return select(v > zero, select(v < one, v, one), zero); };
+  const T volume = select(volumeLambda < zero, -volumeLambda, volumeLambda);
+  return s.betaVolume * clip(volume / s.tauVolume) + s.betaStrain * clip(sqrt(strainSq) / s.tauStrain);
+}
+
+Lane4 lanesAt(const float* v) {
+  Lane4 l;
+  std::memcpy(&l, v, sizeof l);
+  return l;
+}
+
+}  // namespace
+
 float tetSignal(float volumeLambda, const StrainLambda& strainLambda, const HapticSignalSettings& s) {
   float strainSq = 0.0f;
   for (float l : strainLambda) strainSq += l * l;
-  return s.betaVolume * clampUnit(std::abs(volumeLambda) / s.tauVolume) +
-         s.betaStrain * clampUnit(std::sqrt(strainSq) / s.tauStrain);
+  return signalOf(volumeLambda, strainSq, s);
 }
 
-float volumeStrainSignal(std::span<const Vec3> centroids, std::span<const float> tetSignals, const Vec3& graspCentre,
-                         float epsilon) {
+void tetSignals(std::span<const float> volume, std::span<const float> strain, const HapticSignalSettings& s,
+                std::span<float> out) {
+  const std::size_t n = out.size();
+  const bool hasVolume = volume.size() >= n, hasStrain = strain.size() >= kStrainComponents * n;
+  const auto one = [&]<typename T>(std::size_t j, T (*at)(const float*)) {
+    T strainSq = splat<T>(0.0);
+    if (hasStrain)
+      for (int k = 0; k < kStrainComponents; ++k) {
+        const T l = at(&strain[std::size_t(k) * n + j]);
+        strainSq += l * l;
+      }
+    return signalOf(hasVolume ? at(&volume[j]) : splat<T>(0.0), strainSq, s);
+  };
+  std::size_t j = 0;
+  for (; j + 4 <= n; j += 4) {
+    const Lane4 f = one(j, lanesAt);
+    std::memcpy(&out[j], &f, sizeof f);
+  }
+  for (; j < n; ++j)
+    out[j] = one(
+        j, +[](const float* v) { return *v; });
+}
+
+float volumeStrainSignal(const TetSignals& tets, const Vec3& graspCentre, float epsilon) {
+  // Four tets at a time in float; the lanes' sums go into doubles every kBlock tets, so that a
+  // body of 10^5 tets loses no more than one of 10^3 would.
+  constexpr std::size_t kBlock = 256;
+  const std::size_t n = tets.size();
+  const auto lanes = [](const std::vector<float>& v, std::size_t j) { return lanesAt(v.data() + j); };
+  const Lane4 cx = splat<Lane4>(graspCentre.x()), cy = splat<Lane4>(graspCentre.y()),
+              cz = splat<Lane4>(graspCentre.z()), eps = splat<Lane4>(epsilon), one = splat<Lane4>(1.0);
   double weighted = 0.0, weights = 0.0;
-  for (std::size_t j = 0; j < centroids.size() && j < tetSignals.size(); ++j) {
-    const double w = 1.0 / (double((centroids[j] - graspCentre).norm()) + epsilon);
-    weighted += w * tetSignals[j];
+  std::size_t j = 0;
+  while (j + 4 <= n) {
+    const std::size_t blockEnd = std::min(n, j + kBlock);
+    Lane4 w4{}, wf4{};
+    for (; j + 4 <= blockEnd; j += 4) {
+      const Lane4 dx = lanes(tets.x, j) - cx, dy = lanes(tets.y, j) - cy, dz = lanes(tets.z, j) - cz;
+      const Lane4 w = one / (sqrt(dx * dx + dy * dy + dz * dz) + eps);
+      w4 += w;
+      wf4 += w * lanes(tets.f, j);
+    }
+    for (int l = 0; l < 4; ++l) weights += w4[l], weighted += wf4[l];
+  }
+  for (; j < n; ++j) {
+    const Vec3 d = Vec3(tets.x[j], tets.y[j], tets.z[j]) - graspCentre;
+    const float w = 1.0f / (d.norm() + epsilon);
     weights += w;
+    weighted += w * tets.f[j];
   }
   return weights > 0.0 ? clampUnit(float(weighted / weights)) : 0.0f;
 }

@@ -60,8 +60,7 @@ class HapticModel {
 
   HapticSettings settings_;
   HapticFrame frame_;
-  std::vector<Vec3> centroids_;  // per tet of every active body, this step
-  std::vector<float> tetSignal_;
+  TetSignals tets_;  // every tet of every active body, this step
 };
 
 }  // namespace vrd

@@ -5,6 +5,7 @@
 // World and a glove is the hand-interaction layer's job.
 
 #include <span>
+#include <vector>
 
 #include "vrdeform/math/types.h"
 #include "vrdeform/sim/strain_constraint.h"
@@ -35,10 +36,26 @@ float normalisedContact(float lambdaSum, std::size_t contactCount, float tauCont
 /// Eqs. 41-42 for one tet: beta_v clip(|lambda^V| / tau^V) + beta_s clip(||lambda^S|| / tau^S).
 float tetSignal(float volumeLambda, const StrainLambda& strainLambda, const HapticSignalSettings& s);
 
+/// tetSignal() of tets [0, out.size()) of one body, the same values: `volume` holds one multiplier
+/// per tet or none (no volume constraints), `strain` likewise (StrainLambdas' layout, component k
+/// of tet j at k * tets + j). Written so that the compiler runs it over several tets at once.
+void tetSignals(std::span<const float> volume, std::span<const float> strain, const HapticSignalSettings& s,
+                std::span<float> out);
+
+/// The tets' centroids c_j and signals f_j, one array per coordinate so that F_VS runs over
+/// several tets at once.
+struct TetSignals {
+  std::vector<float> x, y, z;  ///< c_j
+  std::vector<float> f;        ///< f_j (tetSignal)
+
+  std::size_t size() const { return f.size(); }
+  void resize(std::size_t n) { x.resize(n), y.resize(n), z.resize(n), f.resize(n); }
+  void setCentroid(std::size_t j, const Vec3& c) { x[j] = c.x(), y[j] = c.y(), z[j] = c.z(); }
+};
+
 /// F_VS (eq. 43's inverse-distance average): sum_j w_j f_j / sum_j w_j with w_j = 1 / (d_j +
-/// epsilon), d_j the distance from tet j's centroid to the grasp centre, f_j its tetSignal().
-float volumeStrainSignal(std::span<const Vec3> centroids, std::span<const float> tetSignals, const Vec3& graspCentre,
-                         float epsilon);
+/// epsilon), d_j the distance from tet j's centroid to the grasp centre. 0 without tets.
+float volumeStrainSignal(const TetSignals& tets, const Vec3& graspCentre, float epsilon);
 
 /// Eq. 43: F_VS when grasping; clip(beta_c lambda^C + (1 - beta_c) F_VS) when some particle is in
 /// contact; 0 otherwise.

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -45,6 +46,7 @@ class StrainLambdas {
     return l;
   }
   float* data() { return values_.data(); }
+  std::span<const float> values() const { return values_; }
   std::size_t bytes() const { return values_.capacity() * sizeof(float); }
 
  private:
