@@ -266,14 +266,13 @@ void bend(const std::vector<BendConstraint>& constraints, float* lambda, float t
   }
 }
 
-// Shape matching: the frame (eqs. 25-27) once, then every particle's goal (eq. 28).
-inline void shapeMatching(const ShapeMatchModel& sm, Vec3* lambda, Eigen::Quaterniond& rotation, float tau,
-                          const Range& r) {
+// Shape matching's goals (eq. 28) for particles [begin, end), given the frame (eqs. 25-27).
+inline void shapeMatchParticles(const ShapeMatchModel& sm, const ShapeMatchFrame& frame, Vec3* lambda, float tau,
+                                const Range& r, std::size_t begin, std::size_t end) {
   Point* pred = r.pred;
   const Point* start = r.start;
-  const ShapeMatchFrame frame = shapeMatchFrame(pred, sm, rotation);
   const XpbdCoefficients k = XpbdCoefficients::make(sm.compliance, tau, r.invH);
-  for (std::size_t i = 0; i < sm.restOffsets.size(); ++i) {
+  for (std::size_t i = begin; i < end; ++i) {
     const Vec3 goal = frame.centroid + frame.rotation * sm.restOffsets[i];
     const Vec3 disp = tau > 0.0f ? Vec3(pred[i].pos - start[i].pos) : Vec3::Zero();
     const Vec3 dLambda = solveShapeMatchParticle(pred[i], goal, lambda[i], k, disp);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <type_traits>
 #include <utility>
 
@@ -409,6 +410,25 @@ void sweepColours(const std::vector<std::uint32_t>& colours, const std::vector<s
   team.barrier();
 }
 
+// Shape matching (eqs. 25-28) of one body by a team: each member sums its parts of the particles,
+// every member adds all parts in order and finds the same frame, and moves its parts' particles.
+void shapeMatching(Body& b, float tau, const sweeps::Range& r, std::span<ShapeMatchSums> sums, const SolverTeam& team) {
+  const ShapeMatchModel& sm = *b.model->shapeMatching;
+  const std::size_t parts = sums.size(), n = sm.restOffsets.size();
+  const auto part = [&](std::size_t k) { return n * k / parts; };
+  const std::size_t first = parts * std::size_t(team.index) / std::size_t(team.size),
+                    last = parts * std::size_t(team.index + 1) / std::size_t(team.size);
+  for (std::size_t k = first; k < last; ++k) sums[k] = shapeMatchSums(r.pred, sm, part(k), part(k + 1));
+  team.barrier();
+  ShapeMatchSums all = sums[0];
+  for (std::size_t k = 1; k < parts; ++k) all += sums[k];
+  Eigen::Quaterniond rotation = b.shapeMatchRotation;
+  const ShapeMatchFrame frame = shapeMatchFrame(all, sm, rotation);
+  sweeps::shapeMatchParticles(sm, frame, b.shapeMatchLambda.data(), tau, r, part(first), part(last));
+  team.barrier();  // every member has read the sums and the last rotation
+  if (team.leader()) b.shapeMatchRotation = rotation;
+}
+
 }  // namespace
 
 void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team) {
@@ -460,8 +480,7 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
                      });
       }
     }
-    if (!team.leader()) continue;  // the rest of the body runs one at a time
-    if (!m.bend.empty()) {
+    if (!m.bend.empty() && team.leader()) {  // one at a time
       StageTimer t(times, Stage::Bend, timed);
       if (tau.bend > 0.0f)
         sweeps::bend<true>(m.bend, b.bendLambda.data(), tau.bend, r);
@@ -469,8 +488,9 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
         sweeps::bend<false>(m.bend, b.bendLambda.data(), tau.bend, r);
     }
     if (m.shapeMatching) {
+      if (!m.bend.empty()) team.barrier();  // shape matching reads every particle
       StageTimer t(times, Stage::ShapeMatching, timed);
-      sweeps::shapeMatching(*m.shapeMatching, b.shapeMatchLambda.data(), b.shapeMatchRotation, tau.shapeMatching, r);
+      shapeMatching(b, tau.shapeMatching, r, shapeMatchSums_, team);
     }
   }
   // The world-level constraints, by the leader; the others wait for it at the end.

@@ -34,21 +34,41 @@ struct ShapeMatchFrame {
   Mat3 rotation;  ///< R
 };
 
-/// Eqs. 25-27: centroid and best-fit rotation of the current positions. `rotation` warm-starts
-/// the extraction and receives the result. In double: a rotation that stops short by float's
-/// 1e-6 rad lags a spinning body, and the goals would then brake the spin every projection.
-inline ShapeMatchFrame shapeMatchFrame(const Point* p, const ShapeMatchModel& model, Eigen::Quaterniond& rotation) {
-  const std::size_t n = model.restOffsets.size();
+/// Eq. 25's sums over some of the particles: sum_i m_i p_i and A_pq. In double: a rotation that
+/// stops short by float's 1e-6 rad lags a spinning body, and the goals would then brake the spin
+/// every projection.
+struct ShapeMatchSums {
   Vec3T<double> weighted = Vec3T<double>::Zero();
   Mat3T<double> Apq = Mat3T<double>::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3T<double> mp = double(model.mass[i]) * p[i].pos.cast<double>();
-    weighted += mp;
-    // sum_i m_i (p_i - c2) q_i^T = sum_i m_i p_i q_i^T because sum_i m_i q_i = 0.
-    Apq.noalias() += mp * model.restOffsets[i].cast<double>().transpose();
+
+  ShapeMatchSums& operator+=(const ShapeMatchSums& o) {
+    weighted += o.weighted;
+    Apq += o.Apq;
+    return *this;
   }
-  extractRotation(Apq, rotation);
-  return {(weighted / double(model.totalMass)).cast<float>(), rotation.toRotationMatrix().cast<float>()};
+};
+
+/// The sums over particles [begin, end).
+inline ShapeMatchSums shapeMatchSums(const Point* p, const ShapeMatchModel& model, std::size_t begin, std::size_t end) {
+  ShapeMatchSums s;
+  for (std::size_t i = begin; i < end; ++i) {
+    const Vec3T<double> mp = double(model.mass[i]) * p[i].pos.cast<double>();
+    s.weighted += mp;
+    // sum_i m_i (p_i - c2) q_i^T = sum_i m_i p_i q_i^T because sum_i m_i q_i = 0.
+    s.Apq.noalias() += mp * model.restOffsets[i].cast<double>().transpose();
+  }
+  return s;
+}
+
+/// Eqs. 25-27: centroid and best-fit rotation from the sums over every particle. `rotation`
+/// warm-starts the extraction and receives the result.
+inline ShapeMatchFrame shapeMatchFrame(const ShapeMatchSums& all, const ShapeMatchModel& model,
+                                       Eigen::Quaterniond& rotation) {
+  extractRotation(all.Apq, rotation);
+  return {(all.weighted / double(model.totalMass)).cast<float>(), rotation.toRotationMatrix().cast<float>()};
+}
+inline ShapeMatchFrame shapeMatchFrame(const Point* p, const ShapeMatchModel& model, Eigen::Quaterniond& rotation) {
+  return shapeMatchFrame(shapeMatchSums(p, model, 0, model.restOffsets.size()), model, rotation);
 }
 
 /// Eq. 28 for one particle: the change of its vector multiplier; its correction is w dLambda.

@@ -169,6 +169,9 @@ class World {
   std::vector<float> fingertipTriangleLambda_;
   std::vector<std::array<Vec3, 3>> fingertipTriangleImpulse_;  // per corner: sum of grad C dLambda this substep
   std::vector<SimEvent> events_;
+  // Shape matching's sums over fixed parts of a body's particles, added in order, so that a team
+  // (each member summing some of the parts) gets the one-thread result.
+  std::array<ShapeMatchSums, 4> shapeMatchSums_;
   StepReport report_;
   std::uint64_t stepCount_ = 0;
 };
