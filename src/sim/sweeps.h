@@ -122,14 +122,20 @@ void oneMultiplier(const C* constraints, std::size_t begin, std::size_t end, flo
                    float C::*rest, Solve solve) {
   const auto batch = [&](std::size_t first, std::size_t count, const C* c) {
     Gathered<T, N, Damped> g(c, count, r.pred, r.start);
-    const auto k = XpbdCoefficientsT<T>::make(fieldOf<T>(c, &C::compliance), splat<T>(tau), r.invH);
-    const auto out = solve(g.x, g.w, fieldOf<T>(c, rest), loadLanes<T>(lambdas + first, count), k, g.displacement());
+    const auto [restValue, compliance] = fieldPairOf<T>(c, rest);  // the compliance follows the rest value
+    const auto k = XpbdCoefficientsT<T>::make(compliance, splat<T>(tau), r.invH);
+    const auto out = solve(g.x, g.w, restValue, loadLanes<T>(lambdas + first, count), k, g.displacement());
     addLanes<T>(lambdas + first, out.dLambda, count);
     g.move(out.dp);
     g.store(r.pred);
   };
   forBatches<T>(begin, end, batch, constraints);
 }
+
+static_assert(offsetof(DistanceConstraint, compliance) == offsetof(DistanceConstraint, restLength) + sizeof(float));
+static_assert(offsetof(VolumeConstraint, compliance) == offsetof(VolumeConstraint, restVolume) + sizeof(float));
+static_assert(offsetof(StrainConstraint, shearCompliance) ==
+              offsetof(StrainConstraint, stretchCompliance) + sizeof(float));
 
 template <typename T, bool Damped>
 [[gnu::flatten]] void distance(const DistanceConstraint* constraints, std::size_t begin, std::size_t end,
@@ -185,11 +191,10 @@ struct StrainLanes {
   VecOf<T> fStart[3];
 
   StrainLanes(const StrainConstraint* c, const float* lambdas, std::size_t tets, std::size_t first, std::size_t count,
-              const ConstraintDamping& damping, float invH, const float* startDeformation)
-      : stretch(XpbdCoefficientsT<T>::make(fieldOf<T>(c, &StrainConstraint::stretchCompliance),
-                                           splat<T>(damping.strainStretch), invH)),
-        shear(XpbdCoefficientsT<T>::make(fieldOf<T>(c, &StrainConstraint::shearCompliance),
-                                         splat<T>(damping.strainShear), invH)) {
+              const ConstraintDamping& damping, float invH, const float* startDeformation) {
+    const auto [stretchCompliance, shearCompliance] = fieldPairOf<T>(c, &StrainConstraint::stretchCompliance);
+    stretch = XpbdCoefficientsT<T>::make(stretchCompliance, splat<T>(damping.strainStretch), invH);
+    shear = XpbdCoefficientsT<T>::make(shearCompliance, splat<T>(damping.strainShear), invH);
     strainWeightsOf<T>(c, a);
     for (int k = 0; k < kStrainComponents; ++k) lambda[k] = loadLanes<T>(lambdas + k * tets + first, count);
     if (startDeformation) loadDeformation<T>(startDeformation, tets, first, count, fStart);
@@ -239,11 +244,10 @@ template <typename T, bool Damped>
     Gathered<T, 4, false> g(c, count, r.pred, r.start);
     const StrainLanes<T> s(c, strainLambdas, tets, first, count, damping, r.invH,
                            Damped ? r.startDeformation : nullptr);
-    const auto k =
-        XpbdCoefficientsT<T>::make(fieldOf<T>(v, &VolumeConstraint::compliance), splat<T>(damping.volume), r.invH);
-    const auto out =
-        solveStrainVolume(g.x, g.w, s.a, s.lambda, s.stretch, s.shear, fieldOf<T>(v, &VolumeConstraint::restVolume),
-                          loadLanes<T>(volumeLambdas + first, count), k, Damped ? s.fStart : nullptr);
+    const auto [restVolume, compliance] = fieldPairOf<T>(v, &VolumeConstraint::restVolume);
+    const auto k = XpbdCoefficientsT<T>::make(compliance, splat<T>(damping.volume), r.invH);
+    const auto out = solveStrainVolume(g.x, g.w, s.a, s.lambda, s.stretch, s.shear, restVolume,
+                                       loadLanes<T>(volumeLambdas + first, count), k, Damped ? s.fStart : nullptr);
     StrainLanes<T>::add(strainLambdas, tets, first, count, out.dLambdaStrain);
     addLanes<T>(volumeLambdas + first, out.dLambdaVolume, count);
     g.move(out.dp);
