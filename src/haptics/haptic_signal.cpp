@@ -26,10 +26,25 @@ T signalOf(T volumeLambda, T strainSq, const HapticSignalSettings& s) {
   return s.betaVolume * clip(volume / s.tauVolume) + s.betaStrain * clip(sqrt(strainSq) / s.tauStrain);
 }
 
-Lane4 lanesAt(const float* v) {
-  Lane4 l;
-  std::memcpy(&l, v, sizeof l);
-  return l;
+// One float (T = float) or four at p.
+template <typename T>
+T loadAt(const float* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// The signals of tets j, j + 1, ... (one per lane of T) of a body of n tets (tetSignals).
+template <typename T>
+T signalsAt(std::span<const float> volume, std::span<const float> strain, std::size_t n, std::size_t j,
+            const HapticSignalSettings& s) {
+  T strainSq = splat<T>(0.0);
+  if (strain.size() >= kStrainComponents * n)
+    for (int k = 0; k < kStrainComponents; ++k) {
+      const T l = loadAt<T>(&strain[std::size_t(k) * n + j]);
+      strainSq += l * l;
+    }
+  return signalOf(volume.size() >= n ? loadAt<T>(&volume[j]) : splat<T>(0.0), strainSq, s);
 }
 
 }  // namespace
@@ -43,24 +58,12 @@ float tetSignal(float volumeLambda, const StrainLambda& strainLambda, const Hapt
 void tetSignals(std::span<const float> volume, std::span<const float> strain, const HapticSignalSettings& s,
                 std::span<float> out) {
   const std::size_t n = out.size();
-  const bool hasVolume = volume.size() >= n, hasStrain = strain.size() >= kStrainComponents * n;
-  const auto one = [&]<typename T>(std::size_t j, T (*at)(const float*)) {
-    T strainSq = splat<T>(0.0);
-    if (hasStrain)
-      for (int k = 0; k < kStrainComponents; ++k) {
-        const T l = at(&strain[std::size_t(k) * n + j]);
-        strainSq += l * l;
-      }
-    return signalOf(hasVolume ? at(&volume[j]) : splat<T>(0.0), strainSq, s);
-  };
   std::size_t j = 0;
   for (; j + 4 <= n; j += 4) {
-    const Lane4 f = one(j, lanesAt);
+    const Lane4 f = signalsAt<Lane4>(volume, strain, n, j, s);
     std::memcpy(&out[j], &f, sizeof f);
   }
-  for (; j < n; ++j)
-    out[j] = one(
-        j, +[](const float* v) { return *v; });
+  for (; j < n; ++j) out[j] = signalsAt<float>(volume, strain, n, j, s);
 }
 
 float volumeStrainSignal(const TetSignals& tets, const Vec3& graspCentre, float epsilon) {
@@ -68,7 +71,7 @@ float volumeStrainSignal(const TetSignals& tets, const Vec3& graspCentre, float 
   // body of 10^5 tets loses no more than one of 10^3 would.
   constexpr std::size_t kBlock = 256;
   const std::size_t n = tets.size();
-  const auto lanes = [](const std::vector<float>& v, std::size_t j) { return lanesAt(v.data() + j); };
+  const auto lanes = [](const std::vector<float>& v, std::size_t j) { return loadAt<Lane4>(&v[j]); };
   const Lane4 cx = splat<Lane4>(graspCentre.x()), cy = splat<Lane4>(graspCentre.y()),
               cz = splat<Lane4>(graspCentre.z()), eps = splat<Lane4>(epsilon), one = splat<Lane4>(1.0);
   double weighted = 0.0, weights = 0.0;

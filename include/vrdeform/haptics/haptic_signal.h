@@ -38,12 +38,12 @@ float tetSignal(float volumeLambda, const StrainLambda& strainLambda, const Hapt
 
 /// tetSignal() of tets [0, out.size()) of one body, the same values: `volume` holds one multiplier
 /// per tet or none (no volume constraints), `strain` likewise (StrainLambdas' layout, component k
-/// of tet j at k * tets + j). Written so that the compiler runs it over several tets at once.
+/// of tet j at k * tets + j), four tets at a time.
 void tetSignals(std::span<const float> volume, std::span<const float> strain, const HapticSignalSettings& s,
                 std::span<float> out);
 
-/// The tets' centroids c_j and signals f_j, one array per coordinate so that F_VS runs over
-/// several tets at once.
+/// The tets' centroids c_j and signals f_j, one array per coordinate so that F_VS runs over four
+/// tets at a time.
 struct TetSignals {
   std::vector<float> x, y, z;  ///< c_j
   std::vector<float> f;        ///< f_j (tetSignal)
