@@ -47,6 +47,14 @@ T signalsAt(std::span<const float> volume, std::span<const float> strain, std::s
   return signalOf(volume.size() >= n ? loadAt<T>(&volume[j]) : splat<T>(0.0), strainSq, s);
 }
 
+// w_j = 1 / (d_j + epsilon) of tets j, j + 1, ... (one per lane of T) seen from `centre` (eq. 42).
+template <typename T>
+T inverseDistanceAt(const TetSignals& tets, std::size_t j, const Vec3& centre, float epsilon) {
+  const T dx = loadAt<T>(&tets.x[j]) - centre.x(), dy = loadAt<T>(&tets.y[j]) - centre.y(),
+          dz = loadAt<T>(&tets.z[j]) - centre.z();
+  return 1.0f / (sqrt(dx * dx + dy * dy + dz * dz) + epsilon);
+}
+
 }  // namespace
 
 float tetSignal(float volumeLambda, const StrainLambda& strainLambda, const HapticSignalSettings& s) {
@@ -67,29 +75,24 @@ void tetSignals(std::span<const float> volume, std::span<const float> strain, co
 }
 
 float volumeStrainSignal(const TetSignals& tets, const Vec3& graspCentre, float epsilon) {
-  // Four tets at a time in float; the lanes' sums go into doubles every kBlock tets, so that a
-  // body of 10^5 tets loses no more than one of 10^3 would.
+  // Four tets at a time in float; the lanes' sums go into doubles every kBlock tets: summed in
+  // float lanes throughout, 10^6 tets would be off by 5e-6.
   constexpr std::size_t kBlock = 256;
   const std::size_t n = tets.size();
-  const auto lanes = [](const std::vector<float>& v, std::size_t j) { return loadAt<Lane4>(&v[j]); };
-  const Lane4 cx = splat<Lane4>(graspCentre.x()), cy = splat<Lane4>(graspCentre.y()),
-              cz = splat<Lane4>(graspCentre.z()), eps = splat<Lane4>(epsilon), one = splat<Lane4>(1.0);
   double weighted = 0.0, weights = 0.0;
   std::size_t j = 0;
   while (j + 4 <= n) {
     const std::size_t blockEnd = std::min(n, j + kBlock);
     Lane4 w4{}, wf4{};
     for (; j + 4 <= blockEnd; j += 4) {
-      const Lane4 dx = lanes(tets.x, j) - cx, dy = lanes(tets.y, j) - cy, dz = lanes(tets.z, j) - cz;
-      const Lane4 w = one / (sqrt(dx * dx + dy * dy + dz * dz) + eps);
+      const Lane4 w = inverseDistanceAt<Lane4>(tets, j, graspCentre, epsilon);
       w4 += w;
-      wf4 += w * lanes(tets.f, j);
+      wf4 += w * loadAt<Lane4>(&tets.f[j]);
     }
     for (int l = 0; l < 4; ++l) weights += w4[l], weighted += wf4[l];
   }
   for (; j < n; ++j) {
-    const Vec3 d = Vec3(tets.x[j], tets.y[j], tets.z[j]) - graspCentre;
-    const float w = 1.0f / (d.norm() + epsilon);
+    const float w = inverseDistanceAt<float>(tets, j, graspCentre, epsilon);
     weights += w;
     weighted += w * tets.f[j];
   }
