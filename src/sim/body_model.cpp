@@ -90,10 +90,6 @@ std::vector<T> permuted(const std::vector<T>& items, const std::vector<Index>& o
   return out;
 }
 
-// Colours with fewer constraints than this are left to the serial remainder: a colour costs the
-// threads a barrier, and one this small would not fill their SIMD lanes.
-constexpr std::size_t kMinColourSize = 8;
-
 // Constraint arrays at least this long are cut in groups for two threads (twoThreadGroups): a
 // group has colours of about a hundred constraints or more, and its thread sweeps them all before
 // it waits. Smaller arrays share every colour between the threads.
@@ -103,8 +99,7 @@ constexpr std::size_t kMinCutConstraints = 4096;
 template <std::size_t N>
 Colouring colourOrder(const std::vector<std::array<Index, N>>& constraints, const std::vector<Vec3>& rest) {
   const bool cut = constraints.size() >= kMinCutConstraints;
-  return colourConstraints(constraints, kMinColourSize, 16,
-                           cut ? twoThreadGroups(constraints, rest) : std::vector<std::uint8_t>{});
+  return colourConstraints(constraints, 16, cut ? twoThreadGroups(constraints, rest) : std::vector<std::uint8_t>{});
 }
 
 // Puts the distance constraints in colour order.

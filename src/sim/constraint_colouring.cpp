@@ -59,8 +59,7 @@ void fillBatches(const std::vector<std::array<Index, N>>& constraints, std::size
 }
 
 template <std::size_t N>
-Colouring colourAll(const std::vector<std::array<Index, N>>& constraints, std::size_t minColourSize,
-                    std::size_t batch) {
+Colouring colourAll(const std::vector<std::array<Index, N>>& constraints, std::size_t batch) {
   constexpr int kNone = -1;
   Index particles = 0;
   for (const auto& c : constraints)
@@ -85,13 +84,11 @@ Colouring colourAll(const std::vector<std::array<Index, N>>& constraints, std::s
   }
   if (batch > 1) fillBatches(constraints, batch, colourOf, size, used);
 
-  // Big colours first (largest first), the small ones and the uncoloured in the remainder.
+  // Largest first (fillBatches may have emptied some), the uncoloured in the remainder.
   std::vector<int> colours;
   for (int c = 0; c < int(size.size()); ++c)
-    if (size[c] >= std::max<std::size_t>(minColourSize, 1)) colours.push_back(c);
+    if (size[c] > 0) colours.push_back(c);
   std::stable_sort(colours.begin(), colours.end(), [&](int a, int b) { return size[a] > size[b]; });
-  std::vector<int> rank(size.size(), kNone);
-  for (int r = 0; r < int(colours.size()); ++r) rank[colours[r]] = r;
 
   Colouring out;
   out.order.reserve(constraints.size());
@@ -102,16 +99,16 @@ Colouring colourAll(const std::vector<std::array<Index, N>>& constraints, std::s
   }
   if (!colours.empty()) out.colourStart.push_back(std::uint32_t(out.order.size()));
   for (std::size_t k = 0; k < constraints.size(); ++k)
-    if (colourOf[k] == kNone || rank[colourOf[k]] == kNone) out.order.push_back(Index(k));
+    if (colourOf[k] == kNone) out.order.push_back(Index(k));
   return out;
 }
 
 }  // namespace
 
 template <std::size_t N>
-Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints, std::size_t minColourSize,
-                            std::size_t batch, const std::vector<std::uint8_t>& groupOf) {
-  if (groupOf.empty()) return colourAll(constraints, minColourSize, batch);
+Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints, std::size_t batch,
+                            const std::vector<std::uint8_t>& groupOf) {
+  if (groupOf.empty()) return colourAll(constraints, batch);
   std::vector<std::vector<Index>> members(std::size_t(*std::max_element(groupOf.begin(), groupOf.end())) + 1);
   for (std::size_t k = 0; k < constraints.size(); ++k) members[groupOf.at(k)].push_back(Index(k));
   Colouring out;
@@ -120,7 +117,7 @@ Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints
     out.groupColours.push_back(std::uint32_t(out.colourStart.size()));
     std::vector<std::array<Index, N>> own;
     for (Index k : group) own.push_back(constraints[k]);
-    const Colouring c = colourAll(own, minColourSize, batch);
+    const Colouring c = colourAll(own, batch);
     const std::size_t base = out.order.size(), coloured = c.colourStart.empty() ? 0 : c.colourStart.back();
     for (std::size_t k = 0; k + 1 < c.colourStart.size(); ++k)
       out.colourStart.push_back(std::uint32_t(base + c.colourStart[k]));
@@ -227,7 +224,7 @@ bool coloursIndependent(const std::vector<std::array<Index, N>>& constraints,
 }
 
 #define VRD_COLOURING(N)                                                                                           \
-  template Colouring colourConstraints<N>(const std::vector<std::array<Index, N>>&, std::size_t, std::size_t,      \
+  template Colouring colourConstraints<N>(const std::vector<std::array<Index, N>>&, std::size_t,                   \
                                           const std::vector<std::uint8_t>&);                                       \
   template std::vector<std::uint8_t> twoThreadGroups<N>(const std::vector<std::array<Index, N>>&,                  \
                                                         const std::vector<Vec3>&);                                 \

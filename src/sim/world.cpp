@@ -364,7 +364,8 @@ namespace {
 //  - one cut in groups for two threads (twoThreadGroups), by a team of two, a pair of groups at a
 //    time: one group each, colour after colour, with a barrier only after each pair; a last
 //    unpaired group and the remainder by the last member;
-//  - otherwise each colour shared by the team, a barrier after each.
+//  - otherwise each colour shared by the team, a barrier after each; a run of colours too small
+//    to give every member a batch by the last member, one barrier after the run.
 // The last member, because the leader has the body's serial work (shape matching, contacts). Only
 // constraints that share no particle run at once, so the result is the one-thread result.
 // `project(sweeps, begin, end)` calls the array's sweep of that width.
@@ -400,9 +401,18 @@ void sweepColours(const std::vector<std::uint32_t>& colours, const std::vector<s
     return;
   }
   constexpr std::size_t kAlign = 16;  // the widest lanes: every share but the last holds whole batches
-  for (std::size_t k = 0; k + 1 < colours.size(); ++k) {
-    const auto [begin, end] = team.share(colours[k], colours[k + 1], kAlign);
-    plan.run(begin, end, project);
+  const auto shared = [&](std::size_t k) { return colours[k + 1] - colours[k] >= kAlign * std::size_t(team.size); };
+  for (std::size_t k = 0; k + 1 < colours.size();) {
+    if (shared(k)) {
+      const auto [begin, end] = team.share(colours[k], colours[k + 1], kAlign);
+      plan.run(begin, end, project);
+      ++k;
+    } else {  // colours too small for a batch each (a group's last): the last member's, one barrier
+      const std::size_t first = k;
+      while (k + 1 < colours.size() && !shared(k)) ++k;
+      if (team.last())
+        for (std::size_t c = first; c < k; ++c) plan.run(colours[c], colours[c + 1], project);
+    }
     team.barrier();
   }
   if (remainder == count) return;  // the last colour's barrier was the last

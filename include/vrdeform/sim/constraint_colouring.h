@@ -12,8 +12,8 @@
 namespace vrd {
 
 /// A solve order: colour k holds order[colourStart[k], colourStart[k + 1]). The constraints from
-/// colourStart.back() on (a few that fit no colour, or were in colours too small to be worth a
-/// pass) follow one at a time in the remainder.
+/// colourStart.back() on (those that fit none of the 64 colours) follow one at a time in the
+/// remainder.
 struct Colouring {
   std::vector<Index> order;                ///< a permutation of the constraints
   std::vector<std::uint32_t> colourStart;  ///< colours + 1 entries; empty: all in the remainder
@@ -27,12 +27,11 @@ struct Colouring {
 /// there is none. Then, where they fit, constraints move out of colours whose size is not a
 /// multiple of `batch` (the widest SIMD lanes) into other such colours, so that fewer batches run
 /// with idle lanes. Within a colour the input order is kept (neighbouring constraints stay near
-/// each other in memory). Colours with fewer than `minColourSize` constraints go to the remainder.
-/// With `groupOf` (each constraint's group, from 0): each group is coloured on its own, group after
-/// group.
+/// each other in memory). Colours are in order of size, largest first. With `groupOf` (each
+/// constraint's group, from 0): each group is coloured on its own, group after group.
 template <std::size_t N>
-Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints, std::size_t minColourSize,
-                            std::size_t batch = 16, const std::vector<std::uint8_t>& groupOf = {});
+Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints, std::size_t batch = 16,
+                            const std::vector<std::uint8_t>& groupOf = {});
 
 /// Points cut into `parts` slabs of (nearly) equal count across x, y or z (not `skipAxis`),
 /// whichever puts the fewest neighbours in the points' order into different slabs: threads
