@@ -256,6 +256,46 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactly) {
   }
 }
 
+// The world's constraints under a team: collider and fingertip contacts shared at a particle
+// boundary, attachments and triangle contacts on the leader. A block in groups dropped on the
+// ground (two colliders, so some particles have two contacts), pressed by a fingertip on its
+// particles and one on its surface triangles, one corner held by an attachment.
+TEST(Lanes, ThreadsGiveTheOneThreadResultExactlyWithContacts) {
+#if defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "libgomp is not built for ThreadSanitizer; its barriers would be reported as races";
+#endif
+  const auto model = dampedBlock(10, {true, true, true, true});
+  ASSERT_EQ(model->tetGroups.size(), 6u);
+  const auto run = [&](int threads, std::size_t& contacts) {
+    SolverSettings s;
+    s.threads = threads;
+    World w(s);
+    const BodyId b = w.addBody(model, Vec3(0.0f, 0.002f, 0.0f));
+    w.addCollider(Collider::plane(Vec3::UnitY()));
+    w.addCollider(Collider::plane(Vec3::UnitX(), Vec3(-0.0495f, 0.0f, 0.0f)));  // a wall at one side
+    w.addFingertip(Vec3(0.0f, 0.108f, 0.0f), 0.01f, 0.0f, FingertipContactMode::Particles);
+    w.addFingertip(Vec3(0.03f, 0.108f, 0.03f), 0.01f, 0.0f, FingertipContactMode::Triangles);
+    w.attach(w.particleIndex(b, 0), model->restPositions[0] + Vec3(0.0f, 0.01f, 0.0f));
+    contacts = 0;
+    for (int step = 0; step < 5; ++step) {
+      w.step();
+      contacts += w.lastStep().colliderContacts + w.lastStep().fingertipContacts;
+    }
+    std::vector<Vec3> x;
+    for (const Point& p : w.particles().x) x.push_back(p.pos);
+    return x;
+  };
+  std::size_t contacts = 0;
+  const std::vector<Vec3> one = run(1, contacts);
+  EXPECT_GT(contacts, 5 * 121u);  // at least the bottom layer, in every step
+  for (int threads : {2, 3}) {
+    std::size_t same = 0;
+    const std::vector<Vec3> many = run(threads, same);
+    EXPECT_EQ(same, contacts);
+    for (std::size_t i = 0; i < one.size(); ++i) ASSERT_EQ(many[i], one[i]) << threads << " threads, particle " << i;
+  }
+}
+
 // The coloured order is another Gauss-Seidel order: it settles to the same static equilibrium as
 // the mesh's order (with any number of threads: see the test above). A block pinned at one end sags under gravity; with
 // enough iterations both orders converge, and the tip's sag agrees to well within the solver's residual.

@@ -503,32 +503,58 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
       shapeMatching(b, tau.shapeMatching, r, shapeMatchSums_, team);
     }
   }
-  // The world-level constraints, by the leader; the others wait for it at the end.
-  if (team.leader()) solveWorldConstraints(invH, timed);
+  solveWorldConstraints(invH, timed, team);
   team.barrier();
 }
 
-// After the bodies' own constraints, so that they have the last word (P3).
-void World::solveWorldConstraints(float invH, bool timed) {
+namespace {
+
+// The part of a contact list (made in particle order) whose particles are in [first, last).
+template <typename Contact>
+std::pair<std::size_t, std::size_t> contactsOf(const std::vector<Contact>& contacts, Index first, Index last) {
+  const auto below = [](const Contact& c, Index p) { return c.particle < p; };
+  return {std::size_t(std::lower_bound(contacts.begin(), contacts.end(), first, below) - contacts.begin()),
+          std::size_t(std::lower_bound(contacts.begin(), contacts.end(), last, below) - contacts.begin())};
+}
+
+}  // namespace
+
+// After the bodies' own constraints, so that they have the last word (P3). Attachments and
+// triangle contacts by the leader. The contacts that move one particle each (colliders, fingertips
+// on particles) are shared by the team at a particle boundary: a particle's contacts stay on one
+// member in their order, so the result is the one-thread result.
+void World::solveWorldConstraints(float invH, bool timed, const SolverTeam& team) {
   StageTimes& times = report_.times;
   Point* const pred = particles_.p.data();
   const Point* const start = particles_.x.data();
   if (!attachments_.empty()) {
-    StageTimer t(times, Stage::Attachment, timed);
-    for (std::size_t a = 0; a < attachments_.size(); ++a) {
-      const Attachment& at = attachments_[a];
-      if (at.particle == kNoParticle) continue;
-      Point& q = pred[at.particle];
-      const Vec3 dLambda =
-          solveAttachment(q, at.target, at.axes, attachmentLambda_[a],
-                          XpbdCoefficients::make(at.compliance, at.dampingTime, invH), q.pos - start[at.particle].pos);
-      attachmentLambda_[a] += dLambda;
-      q.pos += q.w * dLambda;
+    if (team.leader()) {
+      StageTimer t(times, Stage::Attachment, timed);
+      for (std::size_t a = 0; a < attachments_.size(); ++a) {
+        const Attachment& at = attachments_[a];
+        if (at.particle == kNoParticle) continue;
+        Point& q = pred[at.particle];
+        const Vec3 dLambda = solveAttachment(q, at.target, at.axes, attachmentLambda_[a],
+                                             XpbdCoefficients::make(at.compliance, at.dampingTime, invH),
+                                             q.pos - start[at.particle].pos);
+        attachmentLambda_[a] += dLambda;
+        q.pos += q.w * dLambda;
+      }
     }
+    team.barrier();  // an attached particle may touch something too
   }
+  // This member's particles: cut where the collider contacts (the many) are cut evenly.
+  const auto cut = [&](int k) {
+    if (k == team.size) return std::numeric_limits<Index>::max();
+    return k == 0 || colliderContacts_.empty()
+               ? Index(0)
+               : colliderContacts_[colliderContacts_.size() * std::size_t(k) / std::size_t(team.size)].particle;
+  };
+  const Index firstParticle = cut(team.index), lastParticle = cut(team.index + 1);
   if (!colliderContacts_.empty()) {
     StageTimer t(times, Stage::Contact, timed);
-    for (std::size_t c = 0; c < colliderContacts_.size(); ++c) {
+    const auto [begin, end] = contactsOf(colliderContacts_, firstParticle, lastParticle);
+    for (std::size_t c = begin; c < end; ++c) {
       const ColliderContact& con = colliderContacts_[c];
       const Collider& collider = colliders_[con.collider];
       Point& q = pred[con.particle];
@@ -540,9 +566,10 @@ void World::solveWorldConstraints(float invH, bool timed) {
       q.pos += r.dp;
     }
   }
-  if (!fingertipContacts_.empty() || !fingertipTriangleContacts_.empty()) {
+  if (!fingertipContacts_.empty()) {
     StageTimer t(times, Stage::Fingertip, timed);
-    for (std::size_t c = 0; c < fingertipContacts_.size(); ++c) {
+    const auto [begin, end] = contactsOf(fingertipContacts_, firstParticle, lastParticle);
+    for (std::size_t c = begin; c < end; ++c) {
       const FingertipContact& con = fingertipContacts_[c];
       const Fingertip& f = fingertips_[con.fingertip];
       Point& q = pred[con.particle];
@@ -551,6 +578,11 @@ void World::solveWorldConstraints(float invH, bool timed) {
       fingertipLambda_[c] += r.dLambda;
       q.pos += r.dp[0];
     }
+  }
+  if (!fingertipTriangleContacts_.empty()) {
+    team.barrier();  // a triangle's corners may be any member's
+    if (!team.leader()) return;
+    StageTimer t(times, Stage::Fingertip, timed);
     for (std::size_t c = 0; c < fingertipTriangleContacts_.size(); ++c) {
       const FingertipTriangleContact& con = fingertipTriangleContacts_[c];
       const Fingertip& f = fingertips_[con.fingertip];

@@ -149,7 +149,7 @@ class World {
   void solveIterations(float h);
   void startDeformations(const sweeps::LanePlan& plan, const SolverTeam& team);
   void solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team);
-  void solveWorldConstraints(float invH, bool timed);
+  void solveWorldConstraints(float invH, bool timed, const SolverTeam& team);
   void finalise(float h);
   void containNonFinite(BodyId id);
 
