@@ -259,7 +259,8 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactly) {
 // The world's constraints under a team: collider and fingertip contacts shared at a particle
 // boundary, attachments and triangle contacts on the leader. A block in groups dropped on the
 // ground (two colliders, so some particles have two contacts), pressed by a fingertip on its
-// particles and one on its surface triangles, one corner held by an attachment.
+// particles and one on its surface triangles, one corner held by an attachment; beside it a cloth
+// draping over a sphere, whose bending runs on the leader before the contacts.
 TEST(Lanes, ThreadsGiveTheOneThreadResultExactlyWithContacts) {
 #if defined(__SANITIZE_THREAD__)
   GTEST_SKIP() << "libgomp is not built for ThreadSanitizer; its barriers would be reported as races";
@@ -276,6 +277,13 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactlyWithContacts) {
     w.addFingertip(Vec3(0.0f, 0.108f, 0.0f), 0.01f, 0.0f, FingertipContactMode::Particles);
     w.addFingertip(Vec3(0.03f, 0.108f, 0.03f), 0.01f, 0.0f, FingertipContactMode::Triangles);
     w.attach(w.particleIndex(b, 0), model->restPositions[0] + Vec3(0.0f, 0.01f, 0.0f));
+    Material cloth;
+    cloth.particleMass = 0.002f;
+    cloth.distance = {1e-6f, 0.0f};
+    cloth.bending = {0.5f, 0.0f};
+    w.addCollider(Collider::sphere(Vec3(0.2f, 0.0f, 0.1f), 0.05f));  // the cloth drapes over it
+    w.addBody(makeCloth(makeGridCloth(Vec3(0.1f, 0.051f, 0.0f), Vec3(0.2f, 0.0f, 0.0f), Vec3(0.0f, 0.0f, 0.2f), 20, 20),
+                        cloth));
     contacts = 0;
     for (int step = 0; step < 5; ++step) {
       w.step();
@@ -287,7 +295,7 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactlyWithContacts) {
   };
   std::size_t contacts = 0;
   const std::vector<Vec3> one = run(1, contacts);
-  EXPECT_GT(contacts, 5 * 121u);  // at least the bottom layer, in every step
+  EXPECT_GT(contacts, 5 * 121u + 100u);  // the block's bottom layer in every step, and the cloth on the sphere
   for (int threads : {2, 3}) {
     std::size_t same = 0;
     const std::vector<Vec3> many = run(threads, same);

@@ -490,15 +490,17 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
                      });
       }
     }
-    if (!m.bend.empty() && team.leader()) {  // one at a time
-      StageTimer t(times, Stage::Bend, timed);
-      if (tau.bend > 0.0f)
-        sweeps::bend<true>(m.bend, b.bendLambda.data(), tau.bend, r);
-      else
-        sweeps::bend<false>(m.bend, b.bendLambda.data(), tau.bend, r);
+    if (!m.bend.empty()) {
+      if (team.leader()) {  // one at a time
+        StageTimer t(times, Stage::Bend, timed);
+        if (tau.bend > 0.0f)
+          sweeps::bend<true>(m.bend, b.bendLambda.data(), tau.bend, r);
+        else
+          sweeps::bend<false>(m.bend, b.bendLambda.data(), tau.bend, r);
+      }
+      team.barrier();  // shape matching and the shared contacts read and move the same particles
     }
     if (m.shapeMatching) {
-      if (!m.bend.empty()) team.barrier();  // shape matching reads every particle
       StageTimer t(times, Stage::ShapeMatching, timed);
       shapeMatching(b, tau.shapeMatching, r, shapeMatchSums_, team);
     }
