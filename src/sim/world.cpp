@@ -366,7 +366,7 @@ namespace {
 //    unpaired group and the remainder by the last member;
 //  - otherwise each colour shared by the team, a barrier after each; a run of colours too small
 //    to give every member a batch by the last member, one barrier after the run.
-// The last member, because the leader has the body's serial work (shape matching, contacts). Only
+// The last member, because the leader has the serial work (bending, attachments). Only
 // constraints that share no particle run at once, so the result is the one-thread result.
 // `project(sweeps, begin, end)` calls the array's sweep of that width.
 template <typename Project>
