@@ -248,6 +248,8 @@ void World::predict(float h) {
   }
 }
 
+// Contacts in particle order (bodies are appended, so their particles come in body order): the
+// team cuts the lists at particle boundaries (solveWorldConstraints).
 void World::detectContacts() {
   StageTimer timer(report_.times, Stage::Detect, settings_.timeStages);
   colliderContacts_.clear();
