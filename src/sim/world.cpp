@@ -367,7 +367,7 @@ namespace {
 //    time: one group each, colour after colour, with a barrier only after each pair; a last
 //    unpaired group and the remainder by the last member;
 //  - otherwise each colour shared by the team, a barrier after each; a run of colours too small
-//    to give every member a batch by the last member, one barrier after the run.
+//    to give every member a batch, and the remainder, by the last member, one barrier after each.
 // The last member, because the leader has the serial work (bending, attachments). Only
 // constraints that share no particle run at once, so the result is the one-thread result.
 // `project(sweeps, begin, end)` calls the array's sweep of that width.
@@ -418,7 +418,7 @@ void sweepColours(const std::vector<std::uint32_t>& colours, const std::vector<s
     team.barrier();
   }
   if (remainder == count) return;  // the last colour's barrier was the last
-  if (team.leader()) project(sweeps::scalarSweeps(), remainder, count);
+  if (team.last()) project(sweeps::scalarSweeps(), remainder, count);
   team.barrier();
 }
 
