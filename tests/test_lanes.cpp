@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <random>
 
+#include "sim/lane_sweeps.h"
 #include "vrdeform/error.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/constraint_colouring.h"
@@ -230,6 +231,62 @@ TEST(Lanes, EveryWidthAgreesWithTheReferenceLoops) {
     for (Index i = 0; i < model->particleCount(); ++i)
       ASSERT_LT((x[i] - reference[i]).norm(), 1e-5f) << simdName(level) << ", particle " << i;
   }
+}
+
+// Shape matching's goals in lanes: every width gives the one-at-a-time result for any count of
+// particles (so the padded last batch too), damped or not, leaves kinematic particles where they
+// are and writes nothing outside its range.
+TEST(Lanes, ShapeMatchGoalsOfEveryWidthAreTheOneAtATimeGoals) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  const auto vec = [&] { return Vec3(u(rng), u(rng), u(rng)); };
+  constexpr std::size_t n = 40;
+  std::vector<Point> pred(n), start(n);
+  std::vector<Vec3> offsets(n), lambda(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float w = i % 5 == 2 ? 0.0f : 0.5f + 0.5f * std::abs(u(rng));  // some kinematic
+    start[i] = {vec(), w};
+    pred[i] = {start[i].pos + 0.1f * vec(), w};
+    offsets[i] = vec();
+    lambda[i] = 1e-3f * vec();
+  }
+  ShapeMatchFrame frame;
+  frame.centroid = vec();
+  frame.rotation = Eigen::AngleAxisf(0.7f, vec().normalized()).toRotationMatrix();
+  const float compliance = 1e-4f, invH = 600.0f;
+  for (float tau : {0.0f, 0.002f})
+    for (std::size_t begin : {0u, 3u})
+      for (std::size_t count = 0; begin + count <= n; ++count) {
+        const auto goals = [&](SimdLevel level, std::vector<Point>& p, std::vector<Vec3>& l) {
+          p = pred, l = lambda;
+          const sweeps::Range r{p.data(), start.data(), invH, nullptr};
+          sweeps::lanePlan(level).widths[0]->shapeMatch(offsets.data(), compliance, frame, l.data(), tau, r, begin,
+                                                        begin + count);
+        };
+        std::vector<Point> reference;
+        std::vector<Vec3> referenceLambda;
+        goals(SimdLevel::Off, reference, referenceLambda);
+        for (SimdLevel level : {SimdLevel::Sse, SimdLevel::Avx2, SimdLevel::Avx512}) {
+          if (!cpuSupports(level)) continue;
+          std::vector<Point> p;
+          std::vector<Vec3> l;
+          goals(level, p, l);
+          for (std::size_t i = 0; i < n; ++i) {
+            const bool in = i >= begin && i < begin + count;
+            SCOPED_TRACE(::testing::Message() << simdName(level) << ", tau " << tau << ", particles [" << begin << ", "
+                                              << begin + count << "), particle " << i);
+            if (!in || pred[i].w == 0.0f) {  // untouched, bit for bit
+              ASSERT_EQ(p[i].pos, pred[i].pos);
+              ASSERT_EQ(l[i], lambda[i]);
+            } else {
+              ASSERT_NE(l[i], lambda[i]);
+              ASSERT_LT((p[i].pos - reference[i].pos).norm(), 1e-6f);
+              ASSERT_LT((l[i] - referenceLambda[i]).norm(), 1e-6f * referenceLambda[i].norm());
+            }
+            ASSERT_EQ(p[i].w, pred[i].w);
+          }
+        }
+      }
 }
 
 // Two threads sweep a big body's groups two at a time, three share each colour, and a small body

@@ -128,6 +128,40 @@ std::pair<T, T> fieldPairOf(const C* c, float C::*field) {
   }
 }
 
+/// W consecutive Vec3s (12 bytes each, x y z x y z ...) as lanes, and back: per group of four,
+/// three 16-byte loads and six shuffles (never reading past the last Vec3).
+template <typename T>
+V3<T> loadVec3s(const Vec3* v) {
+  Lane4 x[kGroups<T>], y[kGroups<T>], z[kGroups<T>];
+  for (std::size_t g = 0; g < kGroups<T>; ++g) {
+    const float* f = reinterpret_cast<const float*>(v + 4 * g);
+    const __m128 a = _mm_loadu_ps(f), b = _mm_loadu_ps(f + 4), c = _mm_loadu_ps(f + 8);  // x0y0z0x1 y1z1x2y2 z2x3y3z3
+    x[g] = _mm_shuffle_ps(a, _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2)), _MM_SHUFFLE(2, 0, 3, 0));
+    y[g] = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1)), _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 3)),
+                          _MM_SHUFFLE(2, 0, 2, 0));
+    z[g] = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2)), c, _MM_SHUFFLE(3, 0, 2, 0));
+  }
+  return {concat<T>(x), concat<T>(y), concat<T>(z)};
+}
+template <typename T>
+void storeVec3s(Vec3* v, const V3<T>& lanes) {
+  Lane4 x[kGroups<T>], y[kGroups<T>], z[kGroups<T>];
+  split(lanes.x, x), split(lanes.y, y), split(lanes.z, z);
+  for (std::size_t g = 0; g < kGroups<T>; ++g) {
+    float* f = reinterpret_cast<float*>(v + 4 * g);
+    // Each output takes two pairs, each pair from a shuffle that holds it in lanes 0 and 2.
+    const auto pairs = [](__m128 first, __m128 second) {
+      return _mm_shuffle_ps(first, second, _MM_SHUFFLE(2, 0, 2, 0));
+    };
+    _mm_storeu_ps(f, pairs(_mm_shuffle_ps(x[g], y[g], _MM_SHUFFLE(0, 0, 0, 0)),
+                           _mm_shuffle_ps(z[g], x[g], _MM_SHUFFLE(1, 1, 0, 0))));  // x0 y0 z0 x1
+    _mm_storeu_ps(f + 4, pairs(_mm_shuffle_ps(y[g], z[g], _MM_SHUFFLE(1, 1, 1, 1)),
+                               _mm_shuffle_ps(x[g], y[g], _MM_SHUFFLE(2, 2, 2, 2))));  // y1 z1 x2 y2
+    _mm_storeu_ps(f + 8, pairs(_mm_shuffle_ps(z[g], x[g], _MM_SHUFFLE(3, 3, 2, 2)),
+                               _mm_shuffle_ps(y[g], z[g], _MM_SHUFFLE(3, 3, 3, 3))));  // z2 x3 y3 z3
+  }
+}
+
 /// W consecutive floats as lanes, and back; with `count` < W only the first `count` (the rest of
 /// the lanes are zero when loaded and not stored).
 template <typename T>

@@ -270,18 +270,67 @@ void bend(const std::vector<BendConstraint>& constraints, float* lambda, float t
   }
 }
 
-// Shape matching's goals (eq. 28) for particles [begin, end), given the frame (eqs. 25-27).
-inline void shapeMatchParticles(const ShapeMatchModel& sm, const ShapeMatchFrame& frame, Vec3* lambda, float tau,
-                                const Range& r, std::size_t begin, std::size_t end) {
-  Point* pred = r.pred;
-  const Point* start = r.start;
-  const XpbdCoefficients k = XpbdCoefficients::make(sm.compliance, tau, r.invH);
-  for (std::size_t i = begin; i < end; ++i) {
-    const Vec3 goal = frame.centroid + frame.rotation * sm.restOffsets[i];
-    const Vec3 disp = tau > 0.0f ? Vec3(pred[i].pos - start[i].pos) : Vec3::Zero();
-    const Vec3 dLambda = solveShapeMatchParticle(pred[i], goal, lambda[i], k, disp);
-    lambda[i] += dLambda;
-    pred[i].pos += pred[i].w * dLambda;
+// Shape matching's goals (eq. 28) for particles [begin, end) of offsets q (ShapeMatchModel::
+// restOffsets) and multipliers `lambda`, given the frame (eqs. 25-27): one at a time, or
+// kWidth<T> consecutive particles at once and a last batch padded (as in forBatches), so that a
+// particle's rounding depends only on its place after `begin`.
+template <typename T>
+void shapeMatchParticles(const Vec3* q, float compliance, const ShapeMatchFrame& frame, Vec3* lambda, float tau,
+                         const Range& r, std::size_t begin, std::size_t end) {
+  if constexpr (kWidth<T> == 1) {
+    const XpbdCoefficients k = XpbdCoefficients::make(compliance, tau, r.invH);
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vec3 goal = frame.centroid + frame.rotation * q[i];
+      const Vec3 disp = tau > 0.0f ? Vec3(r.pred[i].pos - r.start[i].pos) : Vec3::Zero();
+      const Vec3 dLambda = solveShapeMatchParticle(r.pred[i], goal, lambda[i], k, disp);
+      lambda[i] += dLambda;
+      r.pred[i].pos += r.pred[i].w * dLambda;
+    }
+  } else {
+    constexpr std::size_t W = kWidth<T>;
+    // No Eigen call here (lane_sweeps.h): R's floats column-major, then c2's.
+    const float* R = reinterpret_cast<const float*>(&frame.rotation);
+    const float* c = reinterpret_cast<const float*>(&frame.centroid);
+    const T alphaTilde = splat<T>(compliance * r.invH * r.invH), gamma = splat<T>(tau * r.invH), zero = splat<T>(0.0);
+    Index idx[W];  // W consecutive points from the one given
+    for (std::size_t l = 0; l < W; ++l) idx[l] = Index(l);
+    // solveShapeMatchParticle for W particles; kinematic ones (w = 0) get no change.
+    const auto batch = [&](Point* pred, const Point* start, const Vec3* offsets, Vec3* lambdas, std::size_t count) {
+      V3<T> p, x;
+      T w, ws;
+      loadPoints(pred, idx, 1, p, w);
+      const V3<T> off = loadVec3s<T>(offsets), lambdaNow = loadVec3s<T>(lambdas);
+      const V3<T> goal = {splat<T>(c[0]) + splat<T>(R[0]) * off.x + splat<T>(R[3]) * off.y + splat<T>(R[6]) * off.z,
+                          splat<T>(c[1]) + splat<T>(R[1]) * off.x + splat<T>(R[4]) * off.y + splat<T>(R[7]) * off.z,
+                          splat<T>(c[2]) + splat<T>(R[2]) * off.x + splat<T>(R[5]) * off.y + splat<T>(R[8]) * off.z};
+      V3<T> disp = V3<T>::Zero();
+      if (tau > 0.0f) loadPoints(start, idx, 1, x, ws), disp = p - x;
+      const T alphaTildeOf = alphaTilde * w;  // alpha_i = alpha / m_i
+      const T invDenominator = 1.0f / ((1.0f + gamma) * w + alphaTildeOf);
+      const V3<T> d = (goal - p - alphaTildeOf * lambdaNow - gamma * disp) * invDenominator;
+      const auto moves = w > zero;
+      const V3<T> dLambda = {select(moves, d.x, zero), select(moves, d.y, zero), select(moves, d.z, zero)};
+      storeVec3s<T>(lambdas, lambdaNow + dLambda);
+      storePoints(pred, idx, 1, p + w * dLambda, w, count);
+    };
+    std::size_t i = begin;
+    for (; i + W <= end; i += W) batch(r.pred + i, r.start + i, q + i, lambda + i, W);
+    if (i == end) return;
+    // The rest on copies padded with the first of them; only the real ones are copied back.
+    alignas(16) float pred[4 * W], start[4 * W], offsets[3 * W], lambdas[3 * W];
+    const std::size_t count = end - i;
+    for (std::size_t l = 0; l < W; ++l) {
+      const std::size_t from = i + (l < count ? l : 0);
+      std::memcpy(pred + 4 * l, floats(r.pred + from), 4 * sizeof(float));
+      std::memcpy(start + 4 * l, floats(r.start + from), 4 * sizeof(float));
+      std::memcpy(offsets + 3 * l, q + from, 3 * sizeof(float));
+      std::memcpy(lambdas + 3 * l, lambda + from, 3 * sizeof(float));
+    }
+    const auto points = [](float* f) { return reinterpret_cast<Point*>(f); };
+    const auto vectors = [](float* f) { return reinterpret_cast<Vec3*>(f); };
+    batch(points(pred), points(start), vectors(offsets), vectors(lambdas), count);
+    std::memcpy(floats(r.pred + i), pred, count * sizeof(Point));
+    std::memcpy(static_cast<void*>(lambda + i), lambdas, count * sizeof(Vec3));
   }
 }
 

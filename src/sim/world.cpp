@@ -424,7 +424,9 @@ void sweepColours(const std::vector<std::uint32_t>& colours, const std::vector<s
 
 // Shape matching (eqs. 25-28) of one body by a team: each member sums its parts of the particles,
 // every member adds all parts in order and finds the same frame, and moves its parts' particles.
-void shapeMatching(Body& b, float tau, const sweeps::Range& r, std::span<ShapeMatchSums> sums, const SolverTeam& team) {
+// Each part's goals run in lanes from the part's first particle, so that any team gives the same result.
+void shapeMatching(Body& b, float tau, const sweeps::Range& r, std::span<ShapeMatchSums> sums,
+                   const sweeps::LaneSweeps& lanes, const SolverTeam& team) {
   const ShapeMatchModel& sm = *b.model->shapeMatching;
   const std::size_t parts = sums.size(), n = sm.restOffsets.size();
   const auto part = [&](std::size_t k) { return n * k / parts; };
@@ -436,7 +438,9 @@ void shapeMatching(Body& b, float tau, const sweeps::Range& r, std::span<ShapeMa
   for (std::size_t k = 1; k < parts; ++k) all += sums[k];
   Eigen::Quaterniond rotation = b.shapeMatchRotation;
   const ShapeMatchFrame frame = shapeMatchFrame(all, sm, rotation);
-  sweeps::shapeMatchParticles(sm, frame, b.shapeMatchLambda.data(), tau, r, part(first), part(last));
+  for (std::size_t k = first; k < last; ++k)
+    lanes.shapeMatch(sm.restOffsets.data(), sm.compliance, frame, b.shapeMatchLambda.data(), tau, r, part(k),
+                     part(k + 1));
   team.barrier();  // every member has read the sums and the last rotation
   if (team.leader()) b.shapeMatchRotation = rotation;
 }
@@ -504,7 +508,7 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
     }
     if (m.shapeMatching) {
       StageTimer t(times, Stage::ShapeMatching, timed);
-      shapeMatching(b, tau.shapeMatching, r, shapeMatchSums_, team);
+      shapeMatching(b, tau.shapeMatching, r, shapeMatchSums_, *plan.widths[0], team);
     }
   }
   solveWorldConstraints(invH, timed, team);

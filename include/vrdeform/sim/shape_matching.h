@@ -76,8 +76,9 @@ inline ShapeMatchFrame shapeMatchFrame(const Point* p, const ShapeMatchModel& mo
 inline Vec3 solveShapeMatchParticle(const Point& p, const Vec3& goal, const Vec3& lambda, const XpbdCoefficients& k,
                                     const Vec3& disp = Vec3::Zero()) {
   if (p.w == 0.0f) return Vec3::Zero();
-  const float alphaTilde = k.alphaTilde * p.w;  // alpha_i = alpha / m_i
-  return (goal - p.pos - alphaTilde * lambda - k.gamma * disp) / ((1.0f + k.gamma) * p.w + alphaTilde);
+  const float alphaTilde = k.alphaTilde * p.w;                                // alpha_i = alpha / m_i
+  const float invDenominator = 1.0f / ((1.0f + k.gamma) * p.w + alphaTilde);  // one division, not three
+  return (goal - p.pos - alphaTilde * lambda - k.gamma * disp) * invDenominator;
 }
 
 }  // namespace vrd
