@@ -233,23 +233,44 @@ TEST(Lanes, EveryWidthAgreesWithTheReferenceLoops) {
   }
 }
 
-// Shape matching's goals in lanes: every width gives the one-at-a-time result for any count of
-// particles (so the padded last batch too), damped or not, leaves kinematic particles where they
-// are and writes nothing outside its range.
-TEST(Lanes, ShapeMatchGoalsOfEveryWidthAreTheOneAtATimeGoals) {
+// Shape matching in lanes: for any range of particles (so the padded last batch too), every width
+// gives the one-at-a-time sums (eq. 25) to double precision, and the one-at-a-time goals, damped
+// or not, leaving kinematic particles where they are and writing nothing outside the range.
+TEST(Lanes, ShapeMatchOfEveryWidthIsTheOneAtATimeShapeMatch) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   const auto vec = [&] { return Vec3(u(rng), u(rng), u(rng)); };
   constexpr std::size_t n = 40;
   std::vector<Point> pred(n), start(n);
   std::vector<Vec3> offsets(n), lambda(n);
+  std::vector<float> mass(n);
   for (std::size_t i = 0; i < n; ++i) {
     const float w = i % 5 == 2 ? 0.0f : 0.5f + 0.5f * std::abs(u(rng));  // some kinematic
     start[i] = {vec(), w};
     pred[i] = {start[i].pos + 0.1f * vec(), w};
     offsets[i] = vec();
     lambda[i] = 1e-3f * vec();
+    mass[i] = 1.0f + std::abs(u(rng));
   }
+  // Sums of a body 100 m out: float sums would lose its shape to the cancellation of m_i p_i q_i^T.
+  std::vector<Point> far = pred;
+  for (Point& p : far) p.pos += Vec3(100.0f, -50.0f, 30.0f);
+  for (std::size_t begin : {0u, 3u})
+    for (std::size_t count = 0; begin + count <= n; ++count) {
+      const ShapeMatchSums reference = shapeMatchSums(far.data(), offsets.data(), mass.data(), begin, begin + count);
+      double scale = 1e-300;  // of the terms
+      for (std::size_t i = begin; i < begin + count; ++i) scale += 200.0 * mass[i] * (1.0 + offsets[i].norm());
+      for (SimdLevel level : {SimdLevel::Sse, SimdLevel::Avx2, SimdLevel::Avx512}) {
+        if (!cpuSupports(level)) continue;
+        ShapeMatchSums s;
+        s.Apq.setConstant(7.0);  // overwritten
+        sweeps::lanePlan(level).widths[0]->shapeMatchSums(far.data(), offsets.data(), mass.data(), begin, begin + count,
+                                                          s);
+        ASSERT_LE((s.weighted - reference.weighted).norm(), 1e-14 * scale) << simdName(level) << " " << count;
+        ASSERT_LE((s.Apq - reference.Apq).norm(), 1e-14 * scale) << simdName(level) << " " << count;
+      }
+    }
+
   ShapeMatchFrame frame;
   frame.centroid = vec();
   frame.rotation = Eigen::AngleAxisf(0.7f, vec().normalized()).toRotationMatrix();

@@ -29,6 +29,9 @@ struct LaneSweeps {
   void (*strainVolume)(const StrainConstraint* strain, const VolumeConstraint* volume, std::size_t begin,
                        std::size_t end, float* strainLambda, float* volumeLambda, std::size_t tets,
                        const ConstraintDamping& damping, bool damped, const Range& r);
+  /// eq. 25's sums over particles [begin, end) (any count: the last batch is padded)
+  void (*shapeMatchSums)(const Point* p, const Vec3* restOffsets, const float* mass, std::size_t begin, std::size_t end,
+                         ShapeMatchSums& out);
   /// shape matching's goals for particles [begin, end) (any count: the last batch is padded)
   void (*shapeMatch)(const Vec3* restOffsets, float compliance, const ShapeMatchFrame& frame, Vec3* lambda, float tau,
                      const Range& r, std::size_t begin, std::size_t end);
@@ -59,6 +62,7 @@ LaneSweeps makeLaneSweeps() {
         damped ? strainVolume<T, true>(s, v, begin, end, strainLambda, volumeLambda, tets, damping, r)
                : strainVolume<T, false>(s, v, begin, end, strainLambda, volumeLambda, tets, damping, r);
       },
+      shapeMatchSumsOf<T>,
       shapeMatchParticles<T>,
   };
 }

@@ -270,13 +270,60 @@ void bend(const std::vector<BendConstraint>& constraints, float* lambda, float t
   }
 }
 
+// Eq. 25's sums (shapeMatchSums) over particles [begin, end): with lanes, each product in double
+// as there, in four double lanes per group of four particles, and a last batch padded with
+// massless copies; the lanes are added in a fixed order, so the sums depend only on the range.
+template <typename T>
+[[gnu::flatten]] void shapeMatchSumsOf(const Point* p, const Vec3* q, const float* mass, std::size_t begin,
+                                       std::size_t end, ShapeMatchSums& out) {
+  if constexpr (kWidth<T> == 1) {
+    out = shapeMatchSums(p, q, mass, begin, end);
+  } else {
+    constexpr std::size_t W = kWidth<T>;
+    using Double4 = double __attribute__((vector_size(32)));
+    Double4 sum[12] = {};  // sum_i m_i p_i, then A_pq column-major
+    Index idx[W];
+    for (std::size_t l = 0; l < W; ++l) idx[l] = Index(l);
+    const auto batch = [&](const Point* points, const Vec3* offsets, const float* masses) {
+      V3<T> x;
+      T w;
+      loadPoints(points, idx, 1, x, w);
+      const V3<T> o = loadVec3s<T>(offsets);
+      Lane4 part[7][kGroups<T>];
+      split(x.x, part[0]), split(x.y, part[1]), split(x.z, part[2]);
+      split(o.x, part[3]), split(o.y, part[4]), split(o.z, part[5]);
+      split(loadLanes<T>(masses), part[6]);
+      for (std::size_t g = 0; g < kGroups<T>; ++g) {
+        Double4 v[7];
+        for (int k = 0; k < 7; ++k) v[k] = __builtin_convertvector(part[k][g], Double4);
+        const Double4 mp[3] = {v[6] * v[0], v[6] * v[1], v[6] * v[2]};
+        for (int r = 0; r < 3; ++r) sum[r] += mp[r];
+        for (int c = 0; c < 3; ++c)
+          for (int r = 0; r < 3; ++r) sum[3 + 3 * c + r] += mp[r] * v[3 + c];
+      }
+    };
+    std::size_t i = begin;
+    for (; i + W <= end; i += W) batch(p + i, q + i, mass + i);
+    if (i < end) {
+      alignas(16) float points[4 * W] = {}, offsets[3 * W] = {}, masses[W] = {};
+      std::memcpy(points, floats(p + i), (end - i) * sizeof(Point));
+      std::memcpy(offsets, q + i, (end - i) * sizeof(Vec3));
+      std::memcpy(masses, mass + i, (end - i) * sizeof(float));
+      batch(reinterpret_cast<const Point*>(points), reinterpret_cast<const Vec3*>(offsets), masses);
+    }
+    double* o = reinterpret_cast<double*>(&out.weighted);  // no Eigen call here (lane_sweeps.h)
+    double* a = reinterpret_cast<double*>(&out.Apq);
+    for (int k = 0; k < 12; ++k) (k < 3 ? o[k] : a[k - 3]) = ((sum[k][0] + sum[k][1]) + sum[k][2]) + sum[k][3];
+  }
+}
+
 // Shape matching's goals (eq. 28) for particles [begin, end) of offsets q (ShapeMatchModel::
 // restOffsets) and multipliers `lambda`, given the frame (eqs. 25-27): one at a time, or
 // kWidth<T> consecutive particles at once and a last batch padded (as in forBatches), so that a
 // particle's rounding depends only on its place after `begin`.
 template <typename T>
-void shapeMatchParticles(const Vec3* q, float compliance, const ShapeMatchFrame& frame, Vec3* lambda, float tau,
-                         const Range& r, std::size_t begin, std::size_t end) {
+[[gnu::flatten]] void shapeMatchParticles(const Vec3* q, float compliance, const ShapeMatchFrame& frame, Vec3* lambda,
+                                          float tau, const Range& r, std::size_t begin, std::size_t end) {
   if constexpr (kWidth<T> == 1) {
     const XpbdCoefficients k = XpbdCoefficients::make(compliance, tau, r.invH);
     for (std::size_t i = begin; i < end; ++i) {

@@ -424,7 +424,8 @@ void sweepColours(const std::vector<std::uint32_t>& colours, const std::vector<s
 
 // Shape matching (eqs. 25-28) of one body by a team: each member sums its parts of the particles,
 // every member adds all parts in order and finds the same frame, and moves its parts' particles.
-// Each part's goals run in lanes from the part's first particle, so that any team gives the same result.
+// Each part's sums and goals run in lanes from the part's first particle, so that any team gives
+// the same result.
 void shapeMatching(Body& b, float tau, const sweeps::Range& r, std::span<ShapeMatchSums> sums,
                    const sweeps::LaneSweeps& lanes, const SolverTeam& team) {
   const ShapeMatchModel& sm = *b.model->shapeMatching;
@@ -432,7 +433,8 @@ void shapeMatching(Body& b, float tau, const sweeps::Range& r, std::span<ShapeMa
   const auto part = [&](std::size_t k) { return n * k / parts; };
   const std::size_t first = parts * std::size_t(team.index) / std::size_t(team.size),
                     last = parts * std::size_t(team.index + 1) / std::size_t(team.size);
-  for (std::size_t k = first; k < last; ++k) sums[k] = shapeMatchSums(r.pred, sm, part(k), part(k + 1));
+  for (std::size_t k = first; k < last; ++k)
+    lanes.shapeMatchSums(r.pred, sm.restOffsets.data(), sm.mass.data(), part(k), part(k + 1), sums[k]);
   team.barrier();
   ShapeMatchSums all = sums[0];
   for (std::size_t k = 1; k < parts; ++k) all += sums[k];

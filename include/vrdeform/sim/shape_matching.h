@@ -48,14 +48,15 @@ struct ShapeMatchSums {
   }
 };
 
-/// The sums over particles [begin, end).
-inline ShapeMatchSums shapeMatchSums(const Point* p, const ShapeMatchModel& model, std::size_t begin, std::size_t end) {
+/// The sums over particles [begin, end) with rest offsets q (ShapeMatchModel::restOffsets) and masses.
+inline ShapeMatchSums shapeMatchSums(const Point* p, const Vec3* q, const float* mass, std::size_t begin,
+                                     std::size_t end) {
   ShapeMatchSums s;
   for (std::size_t i = begin; i < end; ++i) {
-    const Vec3T<double> mp = double(model.mass[i]) * p[i].pos.cast<double>();
+    const Vec3T<double> mp = double(mass[i]) * p[i].pos.cast<double>();
     s.weighted += mp;
     // sum_i m_i (p_i - c2) q_i^T = sum_i m_i p_i q_i^T because sum_i m_i q_i = 0.
-    s.Apq.noalias() += mp * model.restOffsets[i].cast<double>().transpose();
+    s.Apq.noalias() += mp * q[i].cast<double>().transpose();
   }
   return s;
 }
@@ -68,7 +69,8 @@ inline ShapeMatchFrame shapeMatchFrame(const ShapeMatchSums& all, const ShapeMat
   return {(all.weighted / double(model.totalMass)).cast<float>(), rotation.toRotationMatrix().cast<float>()};
 }
 inline ShapeMatchFrame shapeMatchFrame(const Point* p, const ShapeMatchModel& model, Eigen::Quaterniond& rotation) {
-  return shapeMatchFrame(shapeMatchSums(p, model, 0, model.restOffsets.size()), model, rotation);
+  return shapeMatchFrame(shapeMatchSums(p, model.restOffsets.data(), model.mass.data(), 0, model.restOffsets.size()),
+                         model, rotation);
 }
 
 /// Eq. 28 for one particle: the change of its vector multiplier; its correction is w dLambda.
