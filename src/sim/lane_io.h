@@ -107,6 +107,20 @@ void storePoints(Point* pts, const Index* idx, std::size_t stride, const V3<T>& 
   }
 }
 
+/// kWidth<T> consecutive points from `pts` as lanes (loadPoints), and back (storePoints).
+template <typename T>
+void loadConsecutivePoints(const Point* pts, V3<T>& x, T& w) {
+  Index idx[kWidth<T>];
+  for (std::size_t l = 0; l < kWidth<T>; ++l) idx[l] = Index(l);
+  loadPoints(pts, idx, 1, x, w);
+}
+template <typename T>
+void storeConsecutivePoints(Point* pts, const V3<T>& x, T w, std::size_t count) {
+  Index idx[kWidth<T>];
+  for (std::size_t l = 0; l < kWidth<T>; ++l) idx[l] = Index(l);
+  storePoints(pts, idx, 1, x, w, count);
+}
+
 /// A per-constraint float field and the one after it (`field` + 1) of W consecutive constraints as
 /// two lanes: per group of four constraints, four 8-byte loads and two shuffles instead of a load
 /// and an insert per lane and field.

@@ -282,12 +282,10 @@ template <typename T>
     constexpr std::size_t W = kWidth<T>;
     using Double4 = double __attribute__((vector_size(32)));
     Double4 sum[12] = {};  // sum_i m_i p_i, then A_pq column-major
-    Index idx[W];
-    for (std::size_t l = 0; l < W; ++l) idx[l] = Index(l);
     const auto batch = [&](const Point* points, const Vec3* offsets, const float* masses) {
       V3<T> x;
       T w;
-      loadPoints(points, idx, 1, x, w);
+      loadConsecutivePoints(points, x, w);
       const V3<T> o = loadVec3s<T>(offsets);
       Lane4 part[7][kGroups<T>];
       split(x.x, part[0]), split(x.y, part[1]), split(x.z, part[2]);
@@ -339,26 +337,24 @@ template <typename T>
     const float* R = reinterpret_cast<const float*>(&frame.rotation);
     const float* c = reinterpret_cast<const float*>(&frame.centroid);
     const T alphaTilde = splat<T>(compliance * r.invH * r.invH), gamma = splat<T>(tau * r.invH), zero = splat<T>(0.0);
-    Index idx[W];  // W consecutive points from the one given
-    for (std::size_t l = 0; l < W; ++l) idx[l] = Index(l);
     // solveShapeMatchParticle for W particles; kinematic ones (w = 0) get no change.
     const auto batch = [&](Point* pred, const Point* start, const Vec3* offsets, Vec3* lambdas, std::size_t count) {
       V3<T> p, x;
       T w, ws;
-      loadPoints(pred, idx, 1, p, w);
+      loadConsecutivePoints(pred, p, w);
       const V3<T> off = loadVec3s<T>(offsets), lambdaNow = loadVec3s<T>(lambdas);
       const V3<T> goal = {splat<T>(c[0]) + splat<T>(R[0]) * off.x + splat<T>(R[3]) * off.y + splat<T>(R[6]) * off.z,
                           splat<T>(c[1]) + splat<T>(R[1]) * off.x + splat<T>(R[4]) * off.y + splat<T>(R[7]) * off.z,
                           splat<T>(c[2]) + splat<T>(R[2]) * off.x + splat<T>(R[5]) * off.y + splat<T>(R[8]) * off.z};
       V3<T> disp = V3<T>::Zero();
-      if (tau > 0.0f) loadPoints(start, idx, 1, x, ws), disp = p - x;
+      if (tau > 0.0f) loadConsecutivePoints(start, x, ws), disp = p - x;
       const T alphaTildeOf = alphaTilde * w;  // alpha_i = alpha / m_i
       const T invDenominator = 1.0f / ((1.0f + gamma) * w + alphaTildeOf);
       const V3<T> d = (goal - p - alphaTildeOf * lambdaNow - gamma * disp) * invDenominator;
       const auto moves = w > zero;
       const V3<T> dLambda = {select(moves, d.x, zero), select(moves, d.y, zero), select(moves, d.z, zero)};
       storeVec3s<T>(lambdas, lambdaNow + dLambda);
-      storePoints(pred, idx, 1, p + w * dLambda, w, count);
+      storeConsecutivePoints(pred, p + w * dLambda, w, count);
     };
     std::size_t i = begin;
     for (; i + W <= end; i += W) batch(r.pred + i, r.start + i, q + i, lambda + i, W);
