@@ -143,7 +143,8 @@ std::pair<T, T> fieldPairOf(const C* c, float C::*field) {
 }
 
 /// W consecutive Vec3s (12 bytes each, x y z x y z ...) as lanes, and back: per group of four,
-/// three 16-byte loads and six shuffles (never reading past the last Vec3).
+/// three 16-byte loads and seven shuffles in, nine shuffles and three stores out (never touching
+/// memory past the last Vec3).
 template <typename T>
 V3<T> loadVec3s(const Vec3* v) {
   Lane4 x[kGroups<T>], y[kGroups<T>], z[kGroups<T>];

@@ -2,7 +2,8 @@
 // One Gauss-Seidel sweep per constraint type over a range of a body's constraints. Distance,
 // volume and strain are written once for every width: T = float (one constraint, Eigen vectors)
 // or a lane type (lanes.h: kWidth<T> consecutive constraints of one colour at once, which is the
-// same sweep as taking them one by one). Bending and shape matching run one at a time.
+// same sweep as taking them one by one). Shape matching's per-particle sums and goals run over
+// consecutive particles at every width; bending runs one at a time.
 
 #include <array>
 #include <cstddef>
