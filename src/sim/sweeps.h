@@ -318,8 +318,8 @@ template <typename T>
 
 // Shape matching's goals (eq. 28) for particles [begin, end) of offsets q (ShapeMatchModel::
 // restOffsets) and multipliers `lambda`, given the frame (eqs. 25-27): one at a time, or
-// kWidth<T> consecutive particles at once and a last batch padded (as in forBatches), so that a
-// particle's rounding depends only on its place after `begin`.
+// kWidth<T> consecutive particles at once and a last batch padded (as in forBatches), so that
+// every particle gets the same arithmetic in whichever batch and lane it falls.
 template <typename T>
 [[gnu::flatten]] void shapeMatchParticles(const Vec3* q, float compliance, const ShapeMatchFrame& frame, Vec3* lambda,
                                           float tau, const Range& r, std::size_t begin, std::size_t end) {

@@ -424,8 +424,8 @@ void sweepColours(const std::vector<std::uint32_t>& colours, const std::vector<s
 
 // Shape matching (eqs. 25-28) of one body by a team: each member sums its parts of the particles,
 // every member adds all parts in order and finds the same frame, and moves its parts' particles.
-// Each part's sums and goals run in lanes from the part's first particle, so that any team gives
-// the same result.
+// Each part's sums run in lanes from the part's first particle, so that any team adds the same
+// terms in the same order.
 void shapeMatching(Body& b, float tau, const sweeps::Range& r, std::span<ShapeMatchSums> sums,
                    const sweeps::LaneSweeps& lanes, const SolverTeam& team) {
   const ShapeMatchModel& sm = *b.model->shapeMatching;
@@ -440,9 +440,8 @@ void shapeMatching(Body& b, float tau, const sweeps::Range& r, std::span<ShapeMa
   for (std::size_t k = 1; k < parts; ++k) all += sums[k];
   Eigen::Quaterniond rotation = b.shapeMatchRotation;
   const ShapeMatchFrame frame = shapeMatchFrame(all, sm, rotation);
-  for (std::size_t k = first; k < last; ++k)
-    lanes.shapeMatch(sm.restOffsets.data(), sm.compliance, frame, b.shapeMatchLambda.data(), tau, r, part(k),
-                     part(k + 1));
+  lanes.shapeMatch(sm.restOffsets.data(), sm.compliance, frame, b.shapeMatchLambda.data(), tau, r, part(first),
+                   part(last));
   team.barrier();  // every member has read the sums and the last rotation
   if (team.leader()) b.shapeMatchRotation = rotation;
 }
