@@ -263,7 +263,7 @@ TEST(Lanes, ShapeMatchOfEveryWidthIsTheOneAtATimeShapeMatch) {
       for (SimdLevel level : {SimdLevel::Sse, SimdLevel::Avx2, SimdLevel::Avx512}) {
         if (!cpuSupports(level)) continue;
         ShapeMatchSums s;
-        s.Apq.setConstant(7.0);  // overwritten
+        s.weighted.setConstant(7.0), s.Apq.setConstant(7.0);  // to be overwritten
         sweeps::lanePlan(level).widths[0]->shapeMatchSums(far.data(), offsets.data(), mass.data(), begin, begin + count,
                                                           s);
         ASSERT_LE((s.weighted - reference.weighted).norm(), 1e-14 * scale) << simdName(level) << " " << count;

@@ -29,10 +29,10 @@ struct LaneSweeps {
   void (*strainVolume)(const StrainConstraint* strain, const VolumeConstraint* volume, std::size_t begin,
                        std::size_t end, float* strainLambda, float* volumeLambda, std::size_t tets,
                        const ConstraintDamping& damping, bool damped, const Range& r);
-  /// eq. 25's sums over particles [begin, end) (any count: the last batch is padded)
+  /// eq. 25's sums over particles [begin, end)
   void (*shapeMatchSums)(const Point* p, const Vec3* restOffsets, const float* mass, std::size_t begin, std::size_t end,
                          ShapeMatchSums& out);
-  /// shape matching's goals for particles [begin, end) (any count: the last batch is padded)
+  /// shape matching's goals (eq. 28) for particles [begin, end)
   void (*shapeMatch)(const Vec3* restOffsets, float compliance, const ShapeMatchFrame& frame, Vec3* lambda, float tau,
                      const Range& r, std::size_t begin, std::size_t end);
 };

@@ -272,18 +272,18 @@ void bend(const std::vector<BendConstraint>& constraints, float* lambda, float t
 }
 
 // Eq. 25's sums (shapeMatchSums) over particles [begin, end): with lanes, each product in double
-// as there, in four double lanes per group of four particles, and a last batch padded with
-// massless copies; the lanes are added in a fixed order, so the sums depend only on the range.
+// as there, in four double lanes per group of four particles, and the padded last batch's extra
+// lanes massless (forBatches); the lanes are added in a fixed order, so the sums depend only on
+// the range.
 template <typename T>
 [[gnu::flatten]] void shapeMatchSumsOf(const Point* p, const Vec3* q, const float* mass, std::size_t begin,
                                        std::size_t end, ShapeMatchSums& out) {
   if constexpr (kWidth<T> == 1) {
     out = shapeMatchSums(p, q, mass, begin, end);
   } else {
-    constexpr std::size_t W = kWidth<T>;
     using Double4 = double __attribute__((vector_size(32)));
     Double4 sum[12] = {};  // sum_i m_i p_i, then A_pq column-major
-    const auto batch = [&](const Point* points, const Vec3* offsets, const float* masses) {
+    const auto batch = [&](std::size_t first, std::size_t count, const Point* points, const Vec3* offsets) {
       V3<T> x;
       T w;
       loadConsecutivePoints(points, x, w);
@@ -291,7 +291,7 @@ template <typename T>
       Lane4 part[7][kGroups<T>];
       split(x.x, part[0]), split(x.y, part[1]), split(x.z, part[2]);
       split(o.x, part[3]), split(o.y, part[4]), split(o.z, part[5]);
-      split(loadLanes<T>(masses), part[6]);
+      split(loadLanes<T>(mass + first, count), part[6]);  // 0 in the padding's lanes
       for (std::size_t g = 0; g < kGroups<T>; ++g) {
         Double4 v[7];
         for (int k = 0; k < 7; ++k) v[k] = __builtin_convertvector(part[k][g], Double4);
@@ -301,15 +301,7 @@ template <typename T>
           for (int r = 0; r < 3; ++r) sum[3 + 3 * c + r] += mp[r] * v[3 + c];
       }
     };
-    std::size_t i = begin;
-    for (; i + W <= end; i += W) batch(p + i, q + i, mass + i);
-    if (i < end) {
-      alignas(16) float points[4 * W] = {}, offsets[3 * W] = {}, masses[W] = {};
-      std::memcpy(points, floats(p + i), (end - i) * sizeof(Point));
-      std::memcpy(offsets, q + i, (end - i) * sizeof(Vec3));
-      std::memcpy(masses, mass + i, (end - i) * sizeof(float));
-      batch(reinterpret_cast<const Point*>(points), reinterpret_cast<const Vec3*>(offsets), masses);
-    }
+    forBatches<T>(begin, end, batch, p, q);
     double* o = reinterpret_cast<double*>(&out.weighted);  // no Eigen call here (lane_sweeps.h)
     double* a = reinterpret_cast<double*>(&out.Apq);
     for (int k = 0; k < 12; ++k) (k < 3 ? o[k] : a[k - 3]) = ((sum[k][0] + sum[k][1]) + sum[k][2]) + sum[k][3];
