@@ -211,19 +211,19 @@ std::vector<SimEvent> World::takeEvents() { return std::exchange(events_, {}); }
 void World::step() {
   report_ = StepReport{};
   report_.step = stepCount_;
-  const int n = settings_.substeps;
-  const float h = settings_.substepSize();
-  for (int s = 0; s < n; ++s) {
-    // Kinematic targets move linearly from where they were to their goals over the step.
-    const float share = 1.0f / float(n - s);
-    for (Attachment& a : attachments_) a.target += share * (a.goal - a.target);
-    for (Fingertip& f : fingertips_) f.center += share * (f.goal - f.center);
-
-    predict(h);
-    detectContacts();
-    resetMultipliers();
-    solveIterations(h);
-    finalise(h);
+  // A team pays only for a body big enough to be cut in groups (body_model.cpp): a smaller array is
+  // swept by one member anyway, and the others would only wait at its barriers.
+  const bool cut = std::any_of(bodies_.begin(), bodies_.end(), [](const Body& b) {
+    return b.state == BodyState::Active && !(b.model->tetGroups.empty() && b.model->distanceGroups.empty());
+  });
+  if (settings_.threads > 1 && cut) {
+    memberContacts_.resize(std::size_t(settings_.threads));
+    memberFinite_.resize(std::size_t(settings_.threads) * bodies_.size());
+#pragma omp parallel num_threads(settings_.threads)
+    substeps(SolverTeam::current());
+  } else {
+    memberFinite_.resize(bodies_.size());
+    substeps(SolverTeam{});
   }
   const auto pushed = [](float l) { return l > 0.0f; };
   report_.colliderContacts =
@@ -234,12 +234,42 @@ void World::step() {
   ++stepCount_;
 }
 
-void World::predict(float h) {
-  StageTimer timer(report_.times, Stage::Predict, settings_.timeStages);
+// Algorithm 1 by a team: each member predicts, detects and finalises its share of the particles,
+// and the barriers sit where one member's work reads another's.
+void World::substeps(const SolverTeam& team) {
+  const int n = settings_.substeps;
+  const float h = settings_.substepSize();
+  const sweeps::LanePlan plan = sweeps::lanePlan(settings_.simd);
+  for (int s = 0; s < n; ++s) {
+    if (team.leader()) {
+      // Kinematic targets move linearly from where they were to their goals over the step.
+      const float share = 1.0f / float(n - s);
+      for (Attachment& a : attachments_) a.target += share * (a.goal - a.target);
+      for (Fingertip& f : fingertips_) f.center += share * (f.goal - f.center);
+    }
+    predict(h, team);
+    team.barrier();  // detection reads the fingertips' new centres
+    detectContacts(team);
+    startDeformations(plan, team);  // its closing barrier also closes detection
+    for (int it = 0; it < settings_.iterations; ++it) solveIteration(h, plan, team);
+    finalise(h, team);
+  }
+}
+
+// This member's share of every particle; each body's part of it is [first, last) clipped to the body.
+std::pair<Index, Index> World::particleShare(const SolverTeam& team) const {
+  const auto [first, last] = team.share(0, particles_.p.size(), 64);  // whole cache lines of Points
+  return {Index(first), Index(last)};
+}
+
+void World::predict(float h, const SolverTeam& team) {
+  StageTimer timer(report_.times, Stage::Predict, settings_.timeStages && team.leader());
   const float keep = std::max(0.0f, 1.0f - settings_.linearDamping * h);
+  const auto [first, last] = particleShare(team);
   for (const Body& b : bodies_) {
     if (b.state != BodyState::Active) continue;
-    for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
+    const Index end = std::min(last, b.firstParticle + b.particleCount);
+    for (Index i = std::max(first, b.firstParticle); i < end; ++i) {
       const Point& x = particles_.x[i];
       Vec3& v = particles_.v[i];
       if (x.w > 0.0f) v = keep * v + h * (settings_.gravity + x.w * particles_.force[i]);  // damp, then add forces
@@ -249,33 +279,64 @@ void World::predict(float h) {
 }
 
 // Contacts in particle order (bodies are appended, so their particles come in body order): the
-// team cuts the lists at particle boundaries (solveWorldConstraints).
-void World::detectContacts() {
-  StageTimer timer(report_.times, Stage::Detect, settings_.timeStages);
-  colliderContacts_.clear();
-  fingertipContacts_.clear();
+// team cuts the lists at particle boundaries (solveWorldConstraints). Each member detects its share
+// of the particles into its own lists, and the leader joins them in member order (so in particle
+// order), then finds the triangle contacts and resets the multipliers while the others go on to
+// startDeformations, whose barrier closes this.
+void World::detectContacts(const SolverTeam& team) {
+  StageTimer timer(report_.times, Stage::Detect, settings_.timeStages && team.leader());
+  const auto [first, last] = particleShare(team);
+  if (team.leader()) {
+    colliderContacts_.clear();
+    fingertipContacts_.clear();
+    detectParticleContacts(first, last, colliderContacts_, fingertipContacts_);
+  } else {
+    MemberContacts& own = memberContacts_[std::size_t(team.index)];
+    own.collider.clear();
+    own.fingertip.clear();
+    detectParticleContacts(first, last, own.collider, own.fingertip);
+  }
+  team.barrier();
+  if (!team.leader()) return;
+  for (int k = 1; k < team.size; ++k) {
+    const MemberContacts& other = memberContacts_[std::size_t(k)];
+    colliderContacts_.insert(colliderContacts_.end(), other.collider.begin(), other.collider.end());
+    fingertipContacts_.insert(fingertipContacts_.end(), other.fingertip.begin(), other.fingertip.end());
+  }
+  detectTriangleContacts();
+  resetMultipliers();
+}
+
+void World::detectParticleContacts(Index first, Index last, std::vector<ColliderContact>& colliderContacts,
+                                   std::vector<FingertipContact>& fingertipContacts) const {
+  const bool tips = std::any_of(fingertips_.begin(), fingertips_.end(), [](const Fingertip& f) {
+    return f.enabled && f.mode == FingertipContactMode::Particles;
+  });
   for (const Body& b : bodies_) {
     if (b.state != BodyState::Active) continue;
     const float radius = b.model->particleRadius;
-    for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
+    const Index end = std::min(last, b.firstParticle + b.particleCount);
+    for (Index i = std::max(first, b.firstParticle); i < end; ++i) {
       const Point& p = particles_.p[i];
       if (p.w == 0.0f) continue;
       // Anything the particle could reach in this substep: its predicted motion as margin. The
       // contacts are inequalities, so candidates that stay clear cost a check and do nothing.
-      const float motion = (p.pos - particles_.x[i].pos).norm();
+      // distance < radius + motion, squared where both sides are positive (no square root).
+      const float motion2 = (p.pos - particles_.x[i].pos).squaredNorm();
       for (Index c = 0; c < colliders_.size(); ++c)
-        if (closestSurface(colliders_[c], p.pos).distance < radius + motion)
-          colliderContacts_.push_back({i, c, radius});
+        if (const float gap = closestSurface(colliders_[c], p.pos).distance - radius; gap < 0.0f || gap * gap < motion2)
+          colliderContacts.push_back({i, c, radius});
+      if (!tips) continue;
       // Eq. 36: N(r) from the predicted positions, widened by the same margin plus a skin, so that
       // a particle resting on the fingertip is not dropped when its prediction lands just outside.
+      const float motion = std::sqrt(motion2);
       for (Index f = 0; f < fingertips_.size(); ++f) {
         if (!fingertips_[f].enabled || fingertips_[f].mode != FingertipContactMode::Particles) continue;
         const float reach = fingertips_[f].radius * (1.0f + kFingertipSkin) + motion;
-        if ((p.pos - fingertips_[f].center).squaredNorm() <= reach * reach) fingertipContacts_.push_back({i, f});
+        if ((p.pos - fingertips_[f].center).squaredNorm() <= reach * reach) fingertipContacts.push_back({i, f});
       }
     }
   }
-  detectTriangleContacts();
 }
 
 // Fingertips in Triangles mode against the active bodies' surface triangles, from the predicted
@@ -321,26 +382,6 @@ void World::resetMultipliers() {
   fingertipLambda_.assign(fingertipContacts_.size(), 0.0f);
   fingertipTriangleLambda_.assign(fingertipTriangleContacts_.size(), 0.0f);
   fingertipTriangleImpulse_.assign(fingertipTriangleContacts_.size(), {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
-}
-
-void World::solveIterations(float h) {
-  const sweeps::LanePlan plan = sweeps::lanePlan(settings_.simd);
-  // A team pays only for a body big enough to be cut in groups (body_model.cpp): a smaller array is
-  // swept by one member anyway, and the others would only wait at its barriers.
-  const bool cut = std::any_of(bodies_.begin(), bodies_.end(), [](const Body& b) {
-    return b.state == BodyState::Active && !(b.model->tetGroups.empty() && b.model->distanceGroups.empty());
-  });
-  if (settings_.threads > 1 && cut) {
-#pragma omp parallel num_threads(settings_.threads)
-    {
-      const SolverTeam team = SolverTeam::current();
-      startDeformations(plan, team);
-      for (int it = 0; it < settings_.iterations; ++it) solveIteration(h, plan, team);
-    }
-  } else {
-    startDeformations(plan, SolverTeam{});
-    for (int it = 0; it < settings_.iterations; ++it) solveIteration(h, plan, SolverTeam{});
-  }
 }
 
 // F of every tet at the start of the substep, for the damped strain sweeps: each member a share.
@@ -608,24 +649,44 @@ void World::solveWorldConstraints(float invH, bool timed, const SolverTeam& team
   }
 }
 
-void World::finalise(float h) {
-  StageTimer timer(report_.times, Stage::Finalise, settings_.timeStages);
+// Each member checks its share of every body, then commits it where no member found a non-finite
+// position; the leader contains the bodies that have one (a barrier after, since that moves all of
+// the body's particles and changes its state, which the next substep's members read).
+void World::finalise(float h, const SolverTeam& team) {
+  StageTimer timer(report_.times, Stage::Finalise, settings_.timeStages && team.leader());
+  enum : std::uint8_t { kNonFinite, kFinite, kInactive };
   const float invH = 1.0f / h;
-  for (BodyId id = 0; id < bodies_.size(); ++id) {
+  const auto [first, last] = particleShare(team);
+  const std::size_t bodies = bodies_.size();
+  const auto part = [&](const Body& b) {
+    return std::pair{std::max(first, b.firstParticle), std::min(last, b.firstParticle + b.particleCount)};
+  };
+  for (BodyId id = 0; id < bodies; ++id) {
     const Body& b = bodies_[id];
-    if (b.state != BodyState::Active) continue;
-    const Index end = b.firstParticle + b.particleCount;
     bool finite = true;
-    for (Index i = b.firstParticle; i < end; ++i) finite &= isFinite(particles_.p[i].pos);
+    if (b.state == BodyState::Active)
+      for (auto [i, end] = part(b); i < end; ++i) finite &= isFinite(particles_.p[i].pos);
+    memberFinite_[std::size_t(team.index) * bodies + id] = b.state != BodyState::Active ? kInactive
+                                                           : finite                     ? kFinite
+                                                                                        : kNonFinite;
+  }
+  team.barrier();
+  bool contained = false;
+  for (BodyId id = 0; id < bodies; ++id) {         // from here on the flags, not the state (the leader may change it)
+    if (memberFinite_[id] == kInactive) continue;  // every member read the same state
+    bool finite = true;
+    for (int k = 0; k < team.size; ++k) finite &= memberFinite_[std::size_t(k) * bodies + id] == kFinite;
     if (!finite) {
-      containNonFinite(id);
+      if (team.leader()) containNonFinite(id);
+      contained = true;
       continue;
     }
-    for (Index i = b.firstParticle; i < end; ++i) {  // Algorithm 1, lines 19-20
+    for (auto [i, end] = part(bodies_[id]); i < end; ++i) {  // Algorithm 1, lines 19-20
       particles_.v[i] = (particles_.p[i].pos - particles_.x[i].pos) * invH;
       particles_.x[i].pos = particles_.p[i].pos;
     }
   }
+  if (contained) team.barrier();
 }
 
 void World::containNonFinite(BodyId id) {

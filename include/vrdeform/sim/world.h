@@ -142,15 +142,18 @@ class World {
   std::vector<Vec3> particleMaterialForces(BodyId id) const;
 
  private:
-  void predict(float h);
-  void detectContacts();
+  void substeps(const SolverTeam& team);
+  std::pair<Index, Index> particleShare(const SolverTeam& team) const;
+  void predict(float h, const SolverTeam& team);
+  void detectContacts(const SolverTeam& team);
+  void detectParticleContacts(Index first, Index last, std::vector<ColliderContact>& colliderContacts,
+                              std::vector<FingertipContact>& fingertipContacts) const;
   void detectTriangleContacts();
   void resetMultipliers();
-  void solveIterations(float h);
   void startDeformations(const sweeps::LanePlan& plan, const SolverTeam& team);
   void solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team);
   void solveWorldConstraints(float invH, bool timed, const SolverTeam& team);
-  void finalise(float h);
+  void finalise(float h, const SolverTeam& team);
   void containNonFinite(BodyId id);
 
   SolverSettings settings_;
@@ -169,6 +172,14 @@ class World {
   std::vector<float> fingertipTriangleLambda_;
   std::vector<std::array<Vec3, 3>> fingertipTriangleImpulse_;  // per corner: sum of grad C dLambda this substep
   std::vector<SimEvent> events_;
+  // A team's scratch: each member's contacts before the leader joins them (the leader's own go
+  // straight to the lists), and which members found their share of each body finite.
+  struct MemberContacts {
+    std::vector<ColliderContact> collider;
+    std::vector<FingertipContact> fingertip;
+  };
+  std::vector<MemberContacts> memberContacts_;
+  std::vector<std::uint8_t> memberFinite_;  // member k, body b at k * bodies + b
   // Shape matching's sums over fixed parts of a body's particles, added in order, so that a team
   // (each member summing some of the parts) gets the one-thread result.
   std::array<ShapeMatchSums, 4> shapeMatchSums_;
