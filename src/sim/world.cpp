@@ -33,13 +33,17 @@ void checkContactMode(FingertipContactMode mode, const char* what) {
     throw Error(fmt::format("{}: unknown fingertip contact mode {}", what, int(mode)));
 }
 
-// Zeroes a body's multipliers (Algorithm 1, line 9).
-void clearMultipliers(Body& b) {
-  std::fill(b.distanceLambda.begin(), b.distanceLambda.end(), 0.0f);
-  std::fill(b.volumeLambda.begin(), b.volumeLambda.end(), 0.0f);
-  b.strainLambda.zero();
-  std::fill(b.bendLambda.begin(), b.bendLambda.end(), 0.0f);
-  std::fill(b.shapeMatchLambda.begin(), b.shapeMatchLambda.end(), Vec3::Zero());
+// Zeroes a body's multipliers (Algorithm 1, line 9): a team member its share of each array.
+void clearMultipliers(Body& b, const SolverTeam& team = SolverTeam{}) {
+  const auto clear = [&]<typename T>(T* values, std::size_t count, const T& zero) {
+    const auto [first, last] = team.share(0, count, 16);
+    std::fill(values + first, values + last, zero);
+  };
+  clear(b.distanceLambda.data(), b.distanceLambda.size(), 0.0f);
+  clear(b.volumeLambda.data(), b.volumeLambda.size(), 0.0f);
+  clear(b.strainLambda.data(), kStrainComponents * b.strainLambda.size(), 0.0f);
+  clear(b.bendLambda.data(), b.bendLambda.size(), 0.0f);
+  clear(b.shapeMatchLambda.data(), b.shapeMatchLambda.size(), Vec3(Vec3::Zero()));
 }
 
 }  // namespace
@@ -281,8 +285,8 @@ void World::predict(float h, const SolverTeam& team) {
 // Contacts in particle order (bodies are appended, so their particles come in body order): the
 // team cuts the lists at particle boundaries (solveWorldConstraints). Each member detects its share
 // of the particles into its own lists, and the leader joins them in member order (so in particle
-// order), then finds the triangle contacts and resets the multipliers while the others go on to
-// startDeformations, whose barrier closes this.
+// order) and finds the triangle contacts; then each member resets its share of the multipliers and
+// goes on to startDeformations, whose barrier closes this.
 void World::detectContacts(const SolverTeam& team) {
   StageTimer timer(report_.times, Stage::Detect, settings_.timeStages && team.leader());
   const auto [first, last] = particleShare(team);
@@ -297,14 +301,15 @@ void World::detectContacts(const SolverTeam& team) {
     detectParticleContacts(first, last, own.collider, own.fingertip);
   }
   team.barrier();
-  if (!team.leader()) return;
-  for (int k = 1; k < team.size; ++k) {
-    const MemberContacts& other = memberContacts_[std::size_t(k)];
-    colliderContacts_.insert(colliderContacts_.end(), other.collider.begin(), other.collider.end());
-    fingertipContacts_.insert(fingertipContacts_.end(), other.fingertip.begin(), other.fingertip.end());
+  if (team.leader()) {
+    for (int k = 1; k < team.size; ++k) {
+      const MemberContacts& other = memberContacts_[std::size_t(k)];
+      colliderContacts_.insert(colliderContacts_.end(), other.collider.begin(), other.collider.end());
+      fingertipContacts_.insert(fingertipContacts_.end(), other.fingertip.begin(), other.fingertip.end());
+    }
+    detectTriangleContacts();
   }
-  detectTriangleContacts();
-  resetMultipliers();
+  resetMultipliers(team);
 }
 
 void World::detectParticleContacts(Index first, Index last, std::vector<ColliderContact>& colliderContacts,
@@ -374,8 +379,10 @@ void World::detectTriangleContacts() {
   }
 }
 
-void World::resetMultipliers() {
-  for (Body& b : bodies_) clearMultipliers(b);
+// The bodies' multipliers by the team; the contacts' and attachments' (once detected) by the leader.
+void World::resetMultipliers(const SolverTeam& team) {
+  for (Body& b : bodies_) clearMultipliers(b, team);
+  if (!team.leader()) return;
   std::fill(attachmentLambda_.begin(), attachmentLambda_.end(), Vec3::Zero());
   contactNormalLambda_.assign(colliderContacts_.size(), 0.0f);
   contactFrictionLambda_.assign(colliderContacts_.size(), Vec3::Zero());

@@ -38,7 +38,6 @@ using StrainLambda = StrainLambdaT<float>;
 class StrainLambdas {
  public:
   void assign(std::size_t tets) { count_ = tets, values_.assign(kStrainComponents * tets, 0.0f); }
-  void zero() { std::fill(values_.begin(), values_.end(), 0.0f); }
   std::size_t size() const { return count_; }
   StrainLambda operator[](std::size_t j) const {
     StrainLambda l;

@@ -149,7 +149,7 @@ class World {
   void detectParticleContacts(Index first, Index last, std::vector<ColliderContact>& colliderContacts,
                               std::vector<FingertipContact>& fingertipContacts) const;
   void detectTriangleContacts();
-  void resetMultipliers();
+  void resetMultipliers(const SolverTeam& team);
   void startDeformations(const sweeps::LanePlan& plan, const SolverTeam& team);
   void solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team);
   void solveWorldConstraints(float invH, bool timed, const SolverTeam& team);
