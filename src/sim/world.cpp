@@ -262,7 +262,9 @@ void World::substeps(const SolverTeam& team) {
 
 // This member's share of every particle; each body's part of it is [first, last) clipped to the body.
 std::pair<Index, Index> World::particleShare(const SolverTeam& team) const {
-  const auto [first, last] = team.share(0, particles_.p.size(), 64);  // whole cache lines of Points
+  // Multiples of 64 particles: the cuts fall on cache line boundaries of the Points (16 bytes) and of
+  // the velocities (12 bytes).
+  const auto [first, last] = team.share(0, particles_.p.size(), 64);
   return {Index(first), Index(last)};
 }
 
@@ -670,17 +672,19 @@ void World::finalise(float h, const SolverTeam& team) {
   };
   for (BodyId id = 0; id < bodies; ++id) {
     const Body& b = bodies_[id];
-    bool finite = true;
-    if (b.state == BodyState::Active)
+    std::uint8_t flag = kInactive;
+    if (b.state == BodyState::Active) {
+      bool finite = true;
       for (auto [i, end] = part(b); i < end; ++i) finite &= isFinite(particles_.p[i].pos);
-    memberFinite_[std::size_t(team.index) * bodies + id] = b.state != BodyState::Active ? kInactive
-                                                           : finite                     ? kFinite
-                                                                                        : kNonFinite;
+      flag = finite ? kFinite : kNonFinite;
+    }
+    memberFinite_[std::size_t(team.index) * bodies + id] = flag;
   }
   team.barrier();
   bool contained = false;
-  for (BodyId id = 0; id < bodies; ++id) {         // from here on the flags, not the state (the leader may change it)
-    if (memberFinite_[id] == kInactive) continue;  // every member read the same state
+  // From here on the flags, not the state, which the leader may change (every member read the same).
+  for (BodyId id = 0; id < bodies; ++id) {
+    if (memberFinite_[id] == kInactive) continue;
     bool finite = true;
     for (int k = 0; k < team.size; ++k) finite &= memberFinite_[std::size_t(k) * bodies + id] == kFinite;
     if (!finite) {

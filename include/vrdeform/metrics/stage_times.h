@@ -10,7 +10,7 @@ namespace vrd {
 
 enum class Stage : std::uint8_t {
   Predict,        ///< forces, damping and predicted positions (Algorithm 1, lines 6-8)
-  Detect,         ///< collider and fingertip contact detection (lines 10-11)
+  Detect,         ///< collider and fingertip contact detection, and the multipliers zeroed (lines 9-11)
   Distance,       ///< stretch constraints
   Volume,         ///< tet volume constraints
   Strain,         ///< tet strain constraints
