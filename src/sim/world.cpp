@@ -260,22 +260,19 @@ void World::substeps(const SolverTeam& team) {
   }
 }
 
-// This member's share of every particle; each body's part of it is [first, last) clipped to the body.
-std::pair<Index, Index> World::particleShare(const SolverTeam& team) const {
-  // Multiples of 64 particles: the cuts fall on cache line boundaries of the Points (16 bytes) and of
-  // the velocities (12 bytes).
+// This member's share of a body's particles: the team cuts all particles at multiples of 64 (cache
+// line boundaries of the Points, 16 bytes, and of the velocities, 12 bytes), then clips to the body.
+std::pair<Index, Index> World::particlesOf(const Body& b, const SolverTeam& team) const {
   const auto [first, last] = team.share(0, particles_.p.size(), 64);
-  return {Index(first), Index(last)};
+  return {std::max(Index(first), b.firstParticle), std::min(Index(last), b.firstParticle + b.particleCount)};
 }
 
 void World::predict(float h, const SolverTeam& team) {
   StageTimer timer(report_.times, Stage::Predict, settings_.timeStages && team.leader());
   const float keep = std::max(0.0f, 1.0f - settings_.linearDamping * h);
-  const auto [first, last] = particleShare(team);
   for (const Body& b : bodies_) {
     if (b.state != BodyState::Active) continue;
-    const Index end = std::min(last, b.firstParticle + b.particleCount);
-    for (Index i = std::max(first, b.firstParticle); i < end; ++i) {
+    for (auto [i, end] = particlesOf(b, team); i < end; ++i) {
       const Point& x = particles_.x[i];
       Vec3& v = particles_.v[i];
       if (x.w > 0.0f) v = keep * v + h * (settings_.gravity + x.w * particles_.force[i]);  // damp, then add forces
@@ -291,17 +288,12 @@ void World::predict(float h, const SolverTeam& team) {
 // goes on to startDeformations, whose barrier closes this.
 void World::detectContacts(const SolverTeam& team) {
   StageTimer timer(report_.times, Stage::Detect, settings_.timeStages && team.leader());
-  const auto [first, last] = particleShare(team);
-  if (team.leader()) {
-    colliderContacts_.clear();
-    fingertipContacts_.clear();
-    detectParticleContacts(first, last, colliderContacts_, fingertipContacts_);
-  } else {
-    MemberContacts& own = memberContacts_[std::size_t(team.index)];
-    own.collider.clear();
-    own.fingertip.clear();
-    detectParticleContacts(first, last, own.collider, own.fingertip);
-  }
+  MemberContacts* const own = team.leader() ? nullptr : &memberContacts_[std::size_t(team.index)];
+  std::vector<ColliderContact>& collider = own ? own->collider : colliderContacts_;
+  std::vector<FingertipContact>& fingertip = own ? own->fingertip : fingertipContacts_;
+  collider.clear();
+  fingertip.clear();
+  detectParticleContacts(team, collider, fingertip);
   team.barrier();
   if (team.leader()) {
     for (int k = 1; k < team.size; ++k) {
@@ -314,7 +306,7 @@ void World::detectContacts(const SolverTeam& team) {
   resetMultipliers(team);
 }
 
-void World::detectParticleContacts(Index first, Index last, std::vector<ColliderContact>& colliderContacts,
+void World::detectParticleContacts(const SolverTeam& team, std::vector<ColliderContact>& colliderContacts,
                                    std::vector<FingertipContact>& fingertipContacts) const {
   const bool tips = std::any_of(fingertips_.begin(), fingertips_.end(), [](const Fingertip& f) {
     return f.enabled && f.mode == FingertipContactMode::Particles;
@@ -322,8 +314,7 @@ void World::detectParticleContacts(Index first, Index last, std::vector<Collider
   for (const Body& b : bodies_) {
     if (b.state != BodyState::Active) continue;
     const float radius = b.model->particleRadius;
-    const Index end = std::min(last, b.firstParticle + b.particleCount);
-    for (Index i = std::max(first, b.firstParticle); i < end; ++i) {
+    for (auto [i, end] = particlesOf(b, team); i < end; ++i) {
       const Point& p = particles_.p[i];
       if (p.w == 0.0f) continue;
       // Anything the particle could reach in this substep: its predicted motion as margin. The
@@ -665,17 +656,13 @@ void World::finalise(float h, const SolverTeam& team) {
   StageTimer timer(report_.times, Stage::Finalise, settings_.timeStages && team.leader());
   enum : std::uint8_t { kNonFinite, kFinite, kInactive };
   const float invH = 1.0f / h;
-  const auto [first, last] = particleShare(team);
   const std::size_t bodies = bodies_.size();
-  const auto part = [&](const Body& b) {
-    return std::pair{std::max(first, b.firstParticle), std::min(last, b.firstParticle + b.particleCount)};
-  };
   for (BodyId id = 0; id < bodies; ++id) {
     const Body& b = bodies_[id];
     std::uint8_t flag = kInactive;
     if (b.state == BodyState::Active) {
       bool finite = true;
-      for (auto [i, end] = part(b); i < end; ++i) finite &= isFinite(particles_.p[i].pos);
+      for (auto [i, end] = particlesOf(b, team); i < end; ++i) finite &= isFinite(particles_.p[i].pos);
       flag = finite ? kFinite : kNonFinite;
     }
     memberFinite_[std::size_t(team.index) * bodies + id] = flag;
@@ -692,7 +679,7 @@ void World::finalise(float h, const SolverTeam& team) {
       contained = true;
       continue;
     }
-    for (auto [i, end] = part(bodies_[id]); i < end; ++i) {  // Algorithm 1, lines 19-20
+    for (auto [i, end] = particlesOf(bodies_[id], team); i < end; ++i) {  // Algorithm 1, lines 19-20
       particles_.v[i] = (particles_.p[i].pos - particles_.x[i].pos) * invH;
       particles_.x[i].pos = particles_.p[i].pos;
     }

@@ -143,10 +143,10 @@ class World {
 
  private:
   void substeps(const SolverTeam& team);
-  std::pair<Index, Index> particleShare(const SolverTeam& team) const;
+  std::pair<Index, Index> particlesOf(const Body& b, const SolverTeam& team) const;
   void predict(float h, const SolverTeam& team);
   void detectContacts(const SolverTeam& team);
-  void detectParticleContacts(Index first, Index last, std::vector<ColliderContact>& colliderContacts,
+  void detectParticleContacts(const SolverTeam& team, std::vector<ColliderContact>& colliderContacts,
                               std::vector<FingertipContact>& fingertipContacts) const;
   void detectTriangleContacts();
   void resetMultipliers(const SolverTeam& team);
