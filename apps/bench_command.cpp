@@ -10,6 +10,7 @@
 #include <string>
 #include <thread>
 
+#include "vrdeform/error.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/metrics/latency_stats.h"
 #include "vrdeform/scene/scene_library.h"
@@ -24,7 +25,9 @@ using nlohmann::json;
 struct BenchArgs {
   bool json = false;
   int frames = 300;
-  bool quick = false;  // skips the 100k-tet scaling row
+  bool quick = false;                // skips the 100k-tet scaling row
+  std::string simdName = "best";     // --simd
+  SimdLevel simd = SimdLevel::Best;  // the lanes of every SIMD figure, from simdName
 };
 
 // The paper's figures (Tables 1-3), ms per frame, Unity/C# on an i7-13700K.
@@ -40,6 +43,13 @@ constexpr PaperRow kTable1[] = {{"furball", 1280, 1.471, 11.972, 0.219, 12.790},
                                 {"bear", 1041, 1.155, 10.467, 0.146, 11.768}};
 constexpr double kFlagTc = 0.573, kFlagTb = 0.693, kFlagTotal = 1.266;
 constexpr double kIdleTotal = 9.27, kContactTotal = 9.72, kContactP99 = 11.38;
+
+// A built-in scene with the lanes asked for (unless the scene runs without lanes).
+SceneSpec benchScene(const std::string& name, const BenchArgs& a) {
+  SceneSpec spec = loadSceneByName(name);
+  if (spec.solver.simd != SimdLevel::Off) spec.solver.simd = a.simd;
+  return spec;
+}
 
 // Runs `spec` settled, without the hand, for `frames` steps; returns the per-stage statistics.
 RunSummary idleRun(SceneSpec spec, int frames) {
@@ -65,7 +75,7 @@ json table1(const BenchArgs& a, std::string& text) {
       fmt::format("{:<9} {:>5} {:>9} | {:>7} {:>7} {:>7} {:>8} | {:>8} | {:>8} {:>8} | {:>8} {:>7}\n", "scene", "tets",
                   "substeps", "T_v", "T_s", "T_m", "T_total", "fused", "paper", "speed-up", "scene's", "loss");
   for (const PaperRow& p : kTable1) {
-    SceneSpec spec = loadSceneByName(p.scene);
+    SceneSpec spec = benchScene(p.scene, a);
     const int sceneSubsteps = spec.solver.substeps;
     spec.solver.substeps = 1;  // the paper's setting
     spec.solver.iterations = 5;
@@ -104,7 +114,7 @@ json table1(const BenchArgs& a, std::string& text) {
 }
 
 json table2(const BenchArgs& a, std::string& text) {
-  SceneSpec spec = loadSceneByName("flag");
+  SceneSpec spec = benchScene("flag", a);
   spec.solver.substeps = 1;  // the paper's settings
   spec.solver.iterations = 2;
   const RunSummary r = idleRun(spec, a.frames);
@@ -125,8 +135,8 @@ json table2(const BenchArgs& a, std::string& text) {
           {"paper_T_total", kFlagTotal}};
 }
 
-json table3(std::string& text) {
-  BuiltScene scene = buildScene(loadSceneByName("liver"));
+json table3(const BenchArgs& a, std::string& text) {
+  BuiltScene scene = buildScene(benchScene("liver", a));
   RunSettings run;
   run.steps = std::uint64_t(std::llround(scene.spec.seconds / scene.spec.solver.timeStep));
   const RunSummary r = runScene(scene, run);
@@ -147,13 +157,14 @@ json table3(std::string& text) {
 
 // The liver's haptic loop in real time at 1 kHz for `seconds`, with a reader taking snapshots at
 // 90 Hz as a viewer would: with the scene's substeps, and with one (h = 1 ms).
-json loop(double seconds, std::string& text) {
+json loop(const BenchArgs& a, std::string& text) {
+  const double seconds = a.quick ? 0.5 : 2.0;
   json rows = json::array();
   text +=
       fmt::format("Loop: the liver scene at 1 kHz in real time for {:g} s, a 90 Hz reader taking snapshots\n", seconds);
   text += fmt::format("{:>9} {:>10} | {:>6} {:>10} {:>9} {:>8} | {:>8} {:>8} {:>8}\n", "substeps", "iterations",
                       "steps", "achieved", "overruns", "resyncs", "p50 (ms)", "P99", "max");
-  SceneSpec spec = loadSceneByName("liver");
+  SceneSpec spec = benchScene("liver", a);
   spec.solver.timeStep = 1e-3f;
   for (int substeps : {spec.solver.substeps, 1}) {
     spec.solver.substeps = substeps;
@@ -215,7 +226,7 @@ double msPerStep(World& world, int frames) {
 
 json scaling(const BenchArgs& a, std::string& text) {
   json rows = json::array();
-  const char* lanes = simdName(resolveSimd(SimdLevel::Best));
+  const char* lanes = simdName(resolveSimd(a.simd));
   text += fmt::format(
       "Scaling: a block of tets on the ground, volume + strain + shape matching, 1 substep x 5 iterations, ms per "
       "step\n{:>8} | {:>10} {:>10} | {:>10} {:>10} | {:>8} {:>8}\n",
@@ -228,7 +239,7 @@ json scaling(const BenchArgs& a, std::string& text) {
     for (int simd = 0; simd < 2; ++simd)
       for (int threads = 1; threads <= 2; ++threads) {
         SolverSettings s;
-        s.simd = simd ? SimdLevel::Best : SimdLevel::Off;
+        s.simd = simd ? a.simd : SimdLevel::Off;
         s.fuseStrainVolume = simd;  // scalar: the paper's order, the baseline
         s.threads = threads;
         s.timeStages = false;
@@ -251,8 +262,9 @@ json scaling(const BenchArgs& a, std::string& text) {
 
 // A full haptic step on a 10k-tet block: predict, contacts with the ground and a fingertip pressing
 // into the top, solve, haptic force. Per-step wall times over `frames` steps of the poke.
-SampleStats pokedBlockSteps(int threads, int frames) {
+SampleStats pokedBlockSteps(SimdLevel simd, int threads, int frames) {
   SolverSettings s;
+  s.simd = simd;
   s.threads = threads;
   s.linearDamping = 1.0f;
   Block b = block(makeBoxTets(Vec3(-0.1f, 0.0f, -0.1f), Vec3::Constant(0.2f), 12, 12, 12), softMaterial(),
@@ -307,7 +319,7 @@ json targets(const BenchArgs& a, const json& table1Rows, std::string& text) {
 
   // 10k tets, a whole haptic step at the loop's rate.
   const int frames = std::max(60, a.frames);
-  const SampleStats one = pokedBlockSteps(1, frames), two = pokedBlockSteps(2, frames);
+  const SampleStats one = pokedBlockSteps(a.simd, 1, frames), two = pokedBlockSteps(a.simd, 2, frames);
   text += fmt::format(
       "  10,368 tets pressed by a fingertip, full step (predict, contacts, solve, force): P99 {:.3f} ms on 2 threads "
       "(mean {:.3f}), {:.3f} ms on 1 (mean {:.3f}); target P99 1.0 ms\n",
@@ -324,6 +336,7 @@ json targets(const BenchArgs& a, const json& table1Rows, std::string& text) {
     const TetMesh cube = makeBoxTets(Vec3(-0.5f, 0.0f, -0.5f), Vec3::Ones(), 26, 26, 26);
     for (auto [substeps, iterations, threads] : {std::tuple{5, 1, 2}, std::tuple{5, 1, 1}, std::tuple{1, 5, 1}}) {
       SolverSettings s;
+      s.simd = a.simd;
       s.substeps = substeps;
       s.iterations = iterations;
       s.threads = threads;
@@ -356,9 +369,9 @@ json targets(const BenchArgs& a, const json& table1Rows, std::string& text) {
 struct Machine {
   std::string cpu = "unknown CPU";  // /proc/cpuinfo's model name
   unsigned threads = std::thread::hardware_concurrency();
-  std::string lanes = simdName(resolveSimd(SimdLevel::Best));
+  std::string lanes;  // those the figures used
 
-  Machine() {
+  explicit Machine(SimdLevel simd) : lanes(simdName(resolveSimd(simd))) {
     std::ifstream info("/proc/cpuinfo");
     for (std::string line; std::getline(info, line);)
       if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos) {
@@ -372,13 +385,14 @@ struct Machine {
 int bench(const BenchArgs& a) {
   std::string text;
   json j;
-  const Machine m;
+  if (!cpuSupports(a.simd)) throw Error(fmt::format("bench: this CPU has no {} lanes", simdName(a.simd)));
+  const Machine m(a.simd);
   j["machine"] = {{"cpu", m.cpu}, {"hardware_threads", m.threads}, {"lanes", m.lanes}};
   j["frames"] = a.frames;
   j["table1"] = table1(a, text);
   j["table2"] = table2(a, text);
-  j["table3"] = table3(text);
-  j["loop"] = loop(a.quick ? 0.5 : 2.0, text);
+  j["table3"] = table3(a, text);
+  j["loop"] = loop(a, text);
   j["scaling"] = scaling(a, text);
   j["targets"] = targets(a, j["table1"], text);
   if (a.json)
@@ -401,7 +415,16 @@ std::function<int()> addBenchCommand(CLI::App& app) {
       ->check(CLI::Range(10, 100000))
       ->capture_default_str();
   cmd->add_flag("--quick", a->quick, "Leave out the 100k-tet scaling row; run the loop for 0.5 s instead of 2");
-  return [a]() { return bench(*a); };
+  cmd->add_option("--simd", a->simdName,
+                  "Lanes of the SIMD figures: best (the widest this CPU has), avx512, avx2 or sse; a narrower set than "
+                  "the CPU's shows what a machine without the wider one would get")
+      ->check(CLI::IsMember({"best", "avx512", "avx2", "sse"}))
+      ->capture_default_str();
+  return [a]() {
+    for (SimdLevel level : {SimdLevel::Best, SimdLevel::Avx512, SimdLevel::Avx2, SimdLevel::Sse})
+      if (a->simdName == simdName(level)) a->simd = level;
+    return bench(*a);
+  };
 }
 
 }  // namespace vrd
