@@ -12,6 +12,7 @@ packages=(
   libpugixml-dev zlib1g-dev   # VTK XML tet meshes
   nlohmann-json3-dev  # WEART middleware JSON messages
   liblo-dev           # OSC output for other haptic devices and tools
+  libsleef-dev        # atan2 in SIMD lanes (the bending constraints)
   libtomlplusplus-dev # scene files
   tetgen              # optional mesher, run as a separate program (AGPL)
   libgtest-dev libgmock-dev googletest   # unit tests

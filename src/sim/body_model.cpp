@@ -265,6 +265,11 @@ std::shared_ptr<const BodyModel> makeCloth(const TriMesh& mesh, const Material& 
     }
   }
   colourDistances(*model, order);
+  if (order == SolveOrder::Coloured) {
+    const Colouring levels = levelOrder(particlesOf(model->bend));
+    model->bend = permuted(model->bend, levels.order);
+    model->bendLevels = levels.colourStart;
+  }
   std::vector<char> used(mesh.vertices.size(), 0);
   for (const Triangle& t : mesh.triangles)
     for (Index v : t) used[v] = 1;
@@ -283,7 +288,7 @@ std::size_t bytesOf(const std::vector<T>& v) {
 std::size_t BodyModel::bytes() const {
   std::size_t n = bytesOf(restPositions) + bytesOf(invMass) + bytesOf(tets) + bytesOf(triangles) + bytesOf(surface) +
                   bytesOf(distance) + bytesOf(volume) + bytesOf(strain) + bytesOf(bend) + bytesOf(distanceColours) +
-                  bytesOf(tetColours) + bytesOf(distanceGroups) + bytesOf(tetGroups);
+                  bytesOf(tetColours) + bytesOf(distanceGroups) + bytesOf(tetGroups) + bytesOf(bendLevels);
   if (shapeMatching) n += bytesOf(shapeMatching->restOffsets) + bytesOf(shapeMatching->mass);
   return n;
 }
@@ -342,6 +347,7 @@ void validateModel(const BodyModel& model) {
   checkColours("distance", model.distance, model.distanceColours, model.distanceGroups);
   checkColours("volume", model.volume, model.tetColours, model.tetGroups);
   checkColours("strain", model.strain, model.tetColours, model.tetGroups);
+  checkColours("bend", model.bend, model.bendLevels, {});
   const ConstraintDamping& d = model.damping;
   for (float beta : {d.distance, d.volume, d.strainStretch, d.strainShear, d.bend, d.shapeMatching})
     if (!finiteNonNegative(beta)) throw Error(fmt::format("damping must be finite and >= 0, got {}", beta));

@@ -157,6 +157,30 @@ Slabs slabsOf(const std::vector<Vec3>& points, int parts, int skipAxis) {
 }
 
 template <std::size_t N>
+Colouring levelOrder(const std::vector<std::array<Index, N>>& constraints) {
+  std::vector<std::uint32_t> levelOf(constraints.size()), next;  // next[p]: the first level free of p
+  std::uint32_t levels = 0;
+  for (std::size_t k = 0; k < constraints.size(); ++k) {
+    std::uint32_t level = 0;
+    for (Index p : constraints[k]) {
+      if (p >= next.size()) next.resize(std::size_t(p) + 1, 0);
+      level = std::max(level, next[p]);
+    }
+    for (Index p : constraints[k]) next[p] = level + 1;
+    levelOf[k] = level;
+    levels = std::max(levels, level + 1);
+  }
+  Colouring out;
+  out.colourStart.assign(levels + 1, 0);
+  for (std::uint32_t level : levelOf) ++out.colourStart[level + 1];
+  for (std::uint32_t l = 0; l < levels; ++l) out.colourStart[l + 1] += out.colourStart[l];
+  out.order.resize(constraints.size());
+  std::vector<std::uint32_t> fill(out.colourStart.begin(), out.colourStart.end() - 1);
+  for (std::size_t k = 0; k < constraints.size(); ++k) out.order[fill[levelOf[k]]++] = Index(k);
+  return out;
+}
+
+template <std::size_t N>
 std::vector<std::uint8_t> twoThreadGroups(const std::vector<std::array<Index, N>>& constraints,
                                           const std::vector<Vec3>& rest) {
   const auto within = [](const std::array<Index, N>& c, const std::vector<std::uint8_t>& slab) {
@@ -226,6 +250,7 @@ bool coloursIndependent(const std::vector<std::array<Index, N>>& constraints,
 #define VRD_COLOURING(N)                                                                                           \
   template Colouring colourConstraints<N>(const std::vector<std::array<Index, N>>&, std::size_t,                   \
                                           const std::vector<std::uint8_t>&);                                       \
+  template Colouring levelOrder<N>(const std::vector<std::array<Index, N>>&);                                      \
   template std::vector<std::uint8_t> twoThreadGroups<N>(const std::vector<std::array<Index, N>>&,                  \
                                                         const std::vector<Vec3>&);                                 \
   template bool coloursIndependent<N>(const std::vector<std::array<Index, N>>&, const std::vector<std::uint32_t>&, \

@@ -19,6 +19,8 @@ struct LaneSweeps {
                    bool damped, const Range& r);
   void (*volume)(const VolumeConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau, bool damped,
                  const Range& r);
+  void (*bend)(const BendConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau, bool damped,
+               const Range& r);
   /// lambda: StrainLambdas::data() of `tets` tets
   void (*strain)(const StrainConstraint* c, std::size_t begin, std::size_t end, float* lambda, std::size_t tets,
                  const ConstraintDamping& damping, bool damped, const Range& r);
@@ -48,6 +50,10 @@ LaneSweeps makeLaneSweeps() {
       [](const VolumeConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau, bool damped,
          const Range& r) {
         damped ? volume<T, true>(c, begin, end, lambda, tau, r) : volume<T, false>(c, begin, end, lambda, tau, r);
+      },
+      [](const BendConstraint* c, std::size_t begin, std::size_t end, float* lambda, float tau, bool damped,
+         const Range& r) {
+        damped ? bend<T, true>(c, begin, end, lambda, tau, r) : bend<T, false>(c, begin, end, lambda, tau, r);
       },
       [](const StrainConstraint* c, std::size_t begin, std::size_t end, float* lambda, std::size_t tets,
          const ConstraintDamping& damping, bool damped, const Range& r) {

@@ -1,9 +1,9 @@
 #pragma once
 // One Gauss-Seidel sweep per constraint type over a range of a body's constraints. Distance,
-// volume and strain are written once for every width: T = float (one constraint, Eigen vectors)
-// or a lane type (lanes.h: kWidth<T> consecutive constraints of one colour at once, which is the
-// same sweep as taking them one by one). Shape matching's per-particle sums and goals run over
-// consecutive particles at every width; bending runs one at a time.
+// volume, strain and bending are written once for every width: T = float (one constraint, Eigen
+// vectors) or a lane type (lanes.h: kWidth<T> consecutive constraints of one colour at once, which
+// is the same sweep as taking them one by one). Shape matching's per-particle sums and goals run
+// over consecutive particles at every width.
 
 #include <array>
 #include <cstddef>
@@ -135,6 +135,7 @@ void oneMultiplier(const C* constraints, std::size_t begin, std::size_t end, flo
 
 static_assert(offsetof(DistanceConstraint, compliance) == offsetof(DistanceConstraint, restLength) + sizeof(float));
 static_assert(offsetof(VolumeConstraint, compliance) == offsetof(VolumeConstraint, restVolume) + sizeof(float));
+static_assert(offsetof(BendConstraint, compliance) == offsetof(BendConstraint, restAngle) + sizeof(float));
 static_assert(offsetof(StrainConstraint, shearCompliance) ==
               offsetof(StrainConstraint, stretchCompliance) + sizeof(float));
 
@@ -257,20 +258,11 @@ template <typename T, bool Damped>
   forBatches<T>(begin, end, batch, strain, volume);
 }
 
-// Bending, one at a time (not yet coloured into lanes, though at the flag's 2 iterations it is most of
-// a cloth's constraint time). Flattened: evalBend and projectScalar inlined into the loop take 29%
-// less time than as calls.
-template <bool Damped>
-[[gnu::flatten]] void bend(const std::vector<BendConstraint>& constraints, float* lambda, float tau, const Range& r) {
-  for (std::size_t c = 0; c < constraints.size(); ++c) {
-    const BendConstraint& con = constraints[c];
-    Gathered<float, 4, Damped> g(&con, 1, r.pred, r.start);
-    const auto out = solveBend(g.x, g.w, con.restAngle, lambda[c], XpbdCoefficients::make(con.compliance, tau, r.invH),
-                               g.displacement());
-    lambda[c] += out.dLambda;
-    g.move(out.dp);
-    g.store(r.pred);
-  }
+template <typename T, bool Damped>
+[[gnu::flatten]] void bend(const BendConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
+                           float tau, const Range& r) {
+  oneMultiplier<T, Damped, 4>(constraints, begin, end, lambdas, tau, r, &BendConstraint::restAngle,
+                              [](const auto&... a) { return solveBend(a...); });
 }
 
 // Eq. 25's sums (shapeMatchSums) over particles [begin, end): with lanes, each product in double

@@ -1,5 +1,11 @@
 // The one-at-a-time and 4-lane sweeps, with the default flags (any x86-64); see lane_sweeps.h.
+#include <sleef.h>
+
 #include "lane_sweeps.h"
+
+namespace vrd {
+Lane4 atan2(Lane4 y, Lane4 x) { return Sleef_atan2f4_u10sse2(y, x); }
+}  // namespace vrd
 
 namespace vrd::sweeps {
 

@@ -409,7 +409,7 @@ namespace {
 //    unpaired group and the remainder by the last member;
 //  - otherwise each colour shared by the team, a barrier after each; a run of colours too small
 //    to give every member a batch, and the remainder, by the last member, one barrier after each.
-// The last member, because the leader has the serial work (bending, attachments). Only
+// The last member, because the leader has the serial work (attachments, triangle contacts). Only
 // constraints that share no particle run at once, so the result is the one-thread result.
 // `project(sweeps, begin, end)` calls the array's sweep of that width.
 template <typename Project>
@@ -539,14 +539,13 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
       }
     }
     if (!m.bend.empty()) {
-      if (team.leader()) {  // one at a time
-        StageTimer t(times, Stage::Bend, timed);
-        if (tau.bend > 0.0f)
-          sweeps::bend<true>(m.bend, b.bendLambda.data(), tau.bend, r);
-        else
-          sweeps::bend<false>(m.bend, b.bendLambda.data(), tau.bend, r);
-      }
-      team.barrier();  // shape matching and the shared contacts read and move the same particles
+      StageTimer t(times, Stage::Bend, timed);
+      const bool damped = tau.bend > 0.0f;
+      static const std::vector<std::uint32_t> noGroups;  // levels are swept by one member (sweepColours)
+      sweepColours(m.bendLevels, noGroups, m.bend.size(), plan, team,
+                   [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
+                     s.bend(m.bend.data(), begin, end, b.bendLambda.data(), tau.bend, damped, r);
+                   });
     }
     if (m.shapeMatching) {
       StageTimer t(times, Stage::ShapeMatching, timed);

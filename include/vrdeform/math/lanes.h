@@ -64,6 +64,17 @@ inline Lane16 sqrt(Lane16 v) {
 }  // _mm512_sqrt_ps trips -Wuninitialized in GCC 12
 #endif
 
+/// atan2 per lane to within 1 ulp (SLEEF, in each width's translation unit: src/sim/sweeps_*.cpp).
+inline float atan2(float y, float x) { return std::atan2(y, x); }
+inline double atan2(double y, double x) { return std::atan2(y, x); }
+Lane4 atan2(Lane4 y, Lane4 x);
+#ifdef __AVX2__
+Lane8 atan2(Lane8 y, Lane8 x);
+#endif
+#ifdef __AVX512F__
+Lane16 atan2(Lane16 y, Lane16 x);
+#endif
+
 template <typename T>
 struct V3 {
   using Scalar = T;

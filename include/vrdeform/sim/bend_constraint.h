@@ -30,41 +30,45 @@ struct BendConstraint {
   float compliance;  ///< alpha (1/(N m))
 };
 
-template <typename S>
+/// V: a 3-vector of scalar S (Vec3, Vec3d) or of lanes (V3<Lane8>: one constraint per lane).
+template <typename V>
 struct BendEval {
-  S theta;           ///< signed bend angle in (-pi, pi]
-  S C;               ///< theta - theta0 wrapped to (-pi, pi]
-  Vec3T<S> grad[4];  ///< zero when a triangle is degenerate
+  using S = typename V::Scalar;
+  S theta;    ///< signed bend angle in (-pi, pi]
+  S C;        ///< theta - theta0 wrapped to (-pi, pi]
+  V grad[4];  ///< zero when a triangle is degenerate
 };
 
-template <typename S>
-BendEval<S> evalBend(const Vec3T<S>& p1, const Vec3T<S>& p2, const Vec3T<S>& p3, const Vec3T<S>& p4, S restAngle) {
-  constexpr S pi = std::numbers::pi_v<S>;
-  BendEval<S> out{};
-  for (auto& g : out.grad) g.setZero();
-  const Vec3T<S> e = p2 - p1;
+template <typename V>
+BendEval<V> evalBend(const V& p1, const V& p2, const V& p3, const V& p4, typename V::Scalar restAngle) {
+  using S = typename V::Scalar;
+  const S pi = splat<S>(std::numbers::pi), zero = splat<S>(0.0);
+  const V e = p2 - p1;
   const S e2 = e.squaredNorm();
-  const Vec3T<S> nA = e.cross(p3 - p1), nB = (p4 - p1).cross(e);
+  const V nA = e.cross(p3 - p1), nB = (p4 - p1).cross(e);
   const S nA2 = nA.squaredNorm(), nB2 = nB.squaredNorm();
-  const S tiny = S(1e-12) * e2 * e2;  // height below 1e-6 |e|
-  if (!(nA2 > tiny && nB2 > tiny)) return out;
-  const S eLength = std::sqrt(e2);
-  out.theta = std::atan2(nA.cross(nB).dot(e) / eLength, nA.dot(nB));
-  out.C = out.theta - restAngle;
-  if (out.C > pi) out.C -= 2 * pi;
-  if (out.C <= -pi) out.C += 2 * pi;
-  const S s3 = (p3 - p1).dot(e) / e2, s4 = (p4 - p1).dot(e) / e2;
-  out.grad[2] = -eLength / nA2 * nA;
-  out.grad[3] = -eLength / nB2 * nB;
-  out.grad[0] = -(1 - s3) * out.grad[2] - (1 - s4) * out.grad[3];
+  const S tiny = splat<S>(1e-12) * e2 * e2;     // height below 1e-6 |e|
+  const auto ok = (nA2 > tiny) & (nB2 > tiny);  // per lane: whatever is computed where not ok is dropped
+  const S eLength = sqrt(e2);
+  BendEval<V> out;
+  out.theta = select(ok, S(atan2(S(nA.cross(nB).dot(e) / eLength), S(nA.dot(nB)))), zero);
+  out.C = select(ok, S(out.theta - restAngle), zero);
+  out.C = select(out.C > pi, S(out.C - 2.0f * pi), out.C);
+  out.C = select(out.C <= -pi, S(out.C + 2.0f * pi), out.C);
+  const S s3 = select(ok, S((p3 - p1).dot(e) / e2), zero), s4 = select(ok, S((p4 - p1).dot(e) / e2), zero);
+  out.grad[2] = select(ok, S(-eLength / nA2), zero) * nA;
+  out.grad[3] = select(ok, S(-eLength / nB2), zero) * nB;
+  out.grad[0] = -(1.0f - s3) * out.grad[2] - (1.0f - s4) * out.grad[3];
   out.grad[1] = -s3 * out.grad[2] - s4 * out.grad[3];
   return out;
 }
 
-/// Eq. 24 projected with eqs. 1 and 3.
-inline Correction<Vec3, 4> solveBend(const Vec3 (&x)[4], const float (&w)[4], float restAngle, float lambda,
-                                     const XpbdCoefficients& k, const Vec3* disp = nullptr) {
-  const BendEval<float> e = evalBend(x[0], x[1], x[2], x[3], restAngle);
+/// Eq. 24 projected with eqs. 1 and 3, for one constraint (V = Vec3) or one per lane (V3<Lane8>).
+template <typename V>
+Correction<V, 4> solveBend(const V (&x)[4], const typename V::Scalar (&w)[4], typename V::Scalar restAngle,
+                           typename V::Scalar lambda, const XpbdCoefficientsT<typename V::Scalar>& k,
+                           const V* disp = nullptr) {
+  const BendEval<V> e = evalBend(x[0], x[1], x[2], x[3], restAngle);
   return projectScalar(w, e.C, e.grad, lambda, k, disp);
 }
 

@@ -33,6 +33,15 @@ template <std::size_t N>
 Colouring colourConstraints(const std::vector<std::array<Index, N>>& constraints, std::size_t batch = 16,
                             const std::vector<std::uint8_t>& groupOf = {});
 
+/// Colours that keep the input order's result: each constraint goes one level after the last
+/// earlier constraint that shares a particle with it (level 0 if none). Constraints of a level
+/// share no particle, and any two that do keep their order, so sweeping the levels one after
+/// another, each at once, gives exactly the one-at-a-time sweep in input order. For constraints
+/// whose Gauss-Seidel order matters, such as bending (world.cpp). Within a level the input order
+/// is kept; no remainder.
+template <std::size_t N>
+Colouring levelOrder(const std::vector<std::array<Index, N>>& constraints);
+
 /// Points cut into `parts` slabs of (nearly) equal count across x, y or z (not `skipAxis`),
 /// whichever puts the fewest neighbours in the points' order into different slabs: threads
 /// sweeping different slabs then seldom write the same cache line.
