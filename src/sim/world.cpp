@@ -541,8 +541,8 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
     if (!m.bend.empty()) {
       StageTimer t(times, Stage::Bend, timed);
       const bool damped = tau.bend > 0.0f;
-      static const std::vector<std::uint32_t> noGroups;  // levels are swept by one member (sweepColours)
-      sweepColours(m.bendLevels, noGroups, m.bend.size(), plan, team,
+      // In levels (levelOrder), without groups: on a team, one member sweeps them all.
+      sweepColours(m.bendLevels, {}, m.bend.size(), plan, team,
                    [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
                      s.bend(m.bend.data(), begin, end, b.bendLambda.data(), tau.bend, damped, r);
                    });
