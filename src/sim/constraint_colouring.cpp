@@ -9,6 +9,15 @@ namespace {
 
 constexpr int kMaxColours = 64;  // one bit per colour in a particle's mask
 
+// One past the highest particle index the constraints use.
+template <std::size_t N>
+Index particleCount(const std::vector<std::array<Index, N>>& constraints) {
+  Index particles = 0;
+  for (const auto& c : constraints)
+    for (Index p : c) particles = std::max(particles, p + 1);
+  return particles;
+}
+
 // Moves constraints out of colours whose last batch of `batch` lanes is partly empty into other
 // such colours where they fit, smallest partial batch first, so that fewer batches run with idle
 // lanes (a partial batch costs about as much as a full one). A colour whose whole partial batch
@@ -61,9 +70,7 @@ void fillBatches(const std::vector<std::array<Index, N>>& constraints, std::size
 template <std::size_t N>
 Colouring colourAll(const std::vector<std::array<Index, N>>& constraints, std::size_t batch) {
   constexpr int kNone = -1;
-  Index particles = 0;
-  for (const auto& c : constraints)
-    for (Index p : c) particles = std::max(particles, p + 1);
+  const Index particles = particleCount(constraints);
   std::vector<std::uint64_t> used(particles, 0);  // colours each particle is in
   std::vector<int> colourOf(constraints.size(), kNone);
   std::vector<std::size_t> size;
@@ -158,14 +165,12 @@ Slabs slabsOf(const std::vector<Vec3>& points, int parts, int skipAxis) {
 
 template <std::size_t N>
 Colouring levelOrder(const std::vector<std::array<Index, N>>& constraints) {
-  std::vector<std::uint32_t> levelOf(constraints.size()), next;  // next[p]: the first level free of p
+  std::vector<std::uint32_t> levelOf(constraints.size());
+  std::vector<std::uint32_t> next(particleCount(constraints), 0);  // next[p]: the first level free of p
   std::uint32_t levels = 0;
   for (std::size_t k = 0; k < constraints.size(); ++k) {
     std::uint32_t level = 0;
-    for (Index p : constraints[k]) {
-      if (p >= next.size()) next.resize(std::size_t(p) + 1, 0);
-      level = std::max(level, next[p]);
-    }
+    for (Index p : constraints[k]) level = std::max(level, next[p]);
     for (Index p : constraints[k]) next[p] = level + 1;
     levelOf[k] = level;
     levels = std::max(levels, level + 1);
@@ -214,9 +219,7 @@ bool coloursIndependent(const std::vector<std::array<Index, N>>& constraints,
                         const std::vector<std::uint32_t>& colourStart, const std::vector<std::uint32_t>& groupColours) {
   if (colourStart.empty()) return groupColours.empty();
   if (colourStart.back() > constraints.size()) return false;
-  Index particles = 0;
-  for (const auto& c : constraints)
-    for (Index p : c) particles = std::max(particles, p + 1);
+  const Index particles = particleCount(constraints);
   constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
   std::vector<std::uint32_t> seenIn(particles, kNone);
   for (std::size_t k = 0; k + 1 < colourStart.size(); ++k) {
