@@ -12,7 +12,7 @@
 #include <string>
 #include <thread>
 
-#include "vrdeform/devices/fake_middleware.h"
+#include "vrdeform/testing/fake_middleware.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
 

@@ -31,7 +31,7 @@
 #include "vrdeform/interact/session_recording.h"
 #include "vrdeform/io/surface_io.h"
 #include "vrdeform/io/tet_io.h"
-#include "vrdeform/io/write_file.h"
+#include "vrdeform/core/write_file.h"
 #include "vrdeform/scene/scene_builder.h"
 #include "vrdeform/sim/world.h"
 

@@ -1,6 +1,6 @@
 #include "vrdeform/devices/csv_recorder.h"
 
-#include "posix_fd.h"
+#include "vrdeform/core/posix_fd.h"
 
 #include <fcntl.h>
 #include <fmt/format.h>

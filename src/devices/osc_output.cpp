@@ -1,7 +1,7 @@
 #include "vrdeform/devices/osc_output.h"
 
 #include "endpoint.h"
-#include "posix_fd.h"
+#include "vrdeform/core/posix_fd.h"
 
 #include <fmt/format.h>
 #include <lo/lo.h>

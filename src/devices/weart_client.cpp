@@ -1,7 +1,7 @@
 #include "vrdeform/devices/weart_client.h"
 
 #include "endpoint.h"
-#include "posix_fd.h"
+#include "vrdeform/core/posix_fd.h"
 
 #include <fcntl.h>
 #include <netdb.h>

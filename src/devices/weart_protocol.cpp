@@ -12,7 +12,7 @@
 #include <system_error>
 #include <utility>
 
-#include "io/json_depth.h"
+#include "vrdeform/core/json_depth.h"
 
 namespace vrd::weart {
 namespace {

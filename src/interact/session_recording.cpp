@@ -8,8 +8,8 @@
 #include <cmath>
 #include <limits>
 
-#include "io/atomic_file.h"
-#include "io/text_tokens.h"
+#include "vrdeform/core/atomic_file.h"
+#include "vrdeform/core/text_tokens.h"
 #include "vrdeform/error.h"
 
 namespace vrd {

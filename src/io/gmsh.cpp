@@ -12,7 +12,7 @@
 
 #include "io/tet_formats.h"
 #include "io/text_out.h"
-#include "io/text_tokens.h"
+#include "vrdeform/core/text_tokens.h"
 #include "vrdeform/error.h"
 
 namespace vrd::io {

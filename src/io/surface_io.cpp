@@ -11,7 +11,7 @@
 #include <fstream>
 #include <unordered_map>
 
-#include "io/atomic_file.h"
+#include "vrdeform/core/atomic_file.h"
 #include "io/binary.h"
 #include "io/extension.h"
 #include "io/ply_reader.h"

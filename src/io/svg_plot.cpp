@@ -10,7 +10,7 @@
 
 #include "io/xml_escape.h"
 #include "vrdeform/error.h"
-#include "vrdeform/io/write_file.h"
+#include "vrdeform/core/write_file.h"
 
 namespace vrd {
 namespace {

@@ -6,10 +6,10 @@
 #include <cctype>
 #include <limits>
 
-#include "io/atomic_file.h"
+#include "vrdeform/core/atomic_file.h"
 #include "io/extension.h"
 #include "io/tet_formats.h"
-#include "io/text_tokens.h"
+#include "vrdeform/core/text_tokens.h"
 #include "vrdeform/error.h"
 
 namespace vrd {

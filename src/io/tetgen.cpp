@@ -6,10 +6,10 @@
 #include <array>
 #include <cmath>
 
-#include "io/atomic_file.h"
+#include "vrdeform/core/atomic_file.h"
 #include "io/tet_formats.h"
 #include "io/text_out.h"
-#include "io/text_tokens.h"
+#include "vrdeform/core/text_tokens.h"
 #include "vrdeform/error.h"
 #include "vrdeform/mesh/boundary.h"
 

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "io/atomic_file.h"
+#include "vrdeform/core/atomic_file.h"
 #include "io/tet_formats.h"
 #include "io/text_out.h"
 #include "io/xml_escape.h"

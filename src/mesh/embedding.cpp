@@ -1,7 +1,11 @@
 #include "vrdeform/mesh/embedding.h"
 
 #include <fmt/format.h>
+
+#if defined(__x86_64__) || defined(__i386__)
+#define VRD_EMBEDDING_X86 1  // the SSE and AVX2 kernels below; elsewhere, one vertex at a time
 #include <immintrin.h>
+#endif
 
 #include <algorithm>
 #include <cstring>
@@ -93,6 +97,32 @@ constexpr int kO = 0, kD = 3, kC = 12;
 struct alignas(32) Frame {
   float v[24];
 };
+
+// One vertex at a time (CPUs other than x86-64): the lanes' maths, with an exact square root where
+// they refine rsqrt.
+template <bool Normals>
+void updatePortable(std::span<const detail::EmbeddingBlock> blocks, const Index* vertexTet, const Frame* frames,
+                    float* outPositions, float* outNormals, std::size_t vertexCount) {
+  constexpr std::size_t kLanes = detail::EmbeddingBlock::kLanes;
+  for (std::size_t v = 0; v < vertexCount; ++v) {
+    const detail::EmbeddingBlock& block = blocks[v / kLanes];
+    const std::size_t l = v % kLanes;
+    const float* f = frames[vertexTet[v]].v;
+    for (int i = 0; i < 3; ++i)
+      outPositions[3 * v + i] = f[kO + i] + f[kD + 3 * i] * block.b[0][l] + f[kD + 3 * i + 1] * block.b[1][l] +
+                                f[kD + 3 * i + 2] * block.b[2][l];
+    if constexpr (Normals) {
+      float n[3];
+      for (int i = 0; i < 3; ++i)
+        n[i] = f[kC + 3 * i] * block.m[0][l] + f[kC + 3 * i + 1] * block.m[1][l] + f[kC + 3 * i + 2] * block.m[2][l];
+      const float len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+      const float r = len2 > 0.0f ? 1.0f / std::sqrt(len2) : 0.0f;  // zero for a loose vertex
+      for (int i = 0; i < 3; ++i) outNormals[3 * v + i] = n[i] * r;
+    }
+  }
+}
+
+#ifdef VRD_EMBEDDING_X86
 struct SseFrame {  // the same, each value in all four lanes
   __m128 v[21];
 };
@@ -261,6 +291,9 @@ bool cpuHasAvx2() {
   }();
   return has;
 }
+#else
+bool cpuHasAvx2() { return false; }
+#endif
 
 }  // namespace
 
@@ -390,6 +423,7 @@ void Embedding::updateStrided(const Vec3* first, std::size_t strideBytes, std::s
 
   float* outP = outPositions.data()->data();
   float* outN = normals ? outNormals.data()->data() : nullptr;
+#ifdef VRD_EMBEDDING_X86
   if (usesAvx2()) {
     (normals ? updateAvx2<true> : updateAvx2<false>)(blocks_, blockTet_.data(), vertexTet_.data(), frames.data(), outP,
                                                      outN, vertexCount_);
@@ -400,6 +434,10 @@ void Embedding::updateStrided(const Vec3* first, std::size_t strideBytes, std::s
     (normals ? updateSse<true> : updateSse<false>)(blocks_, blockTet_.data(), vertexTet_.data(), sse.data(), outP, outN,
                                                    vertexCount_);
   }
+#else
+  (normals ? updatePortable<true> : updatePortable<false>)(blocks_, vertexTet_.data(), frames.data(), outP, outN,
+                                                           vertexCount_);
+#endif
   if (!anyFlat) return;
 
   // Flat, collapsed or (for non-finite input) broken tets, per vertex in double: cof(F) n, else

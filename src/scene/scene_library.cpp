@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cstdlib>
 
-#include "io/installed_data.h"
+#include "vrdeform/core/installed_data.h"
 #include "vrdeform/error.h"
 #include "vrdeform/scene/scene_file.h"
 

@@ -13,7 +13,7 @@
 #include "vrdeform/error.h"
 #include "vrdeform/io/svg_plot.h"
 #include "vrdeform/io/vtu_sequence.h"
-#include "vrdeform/io/write_file.h"
+#include "vrdeform/core/write_file.h"
 
 namespace vrd {
 namespace {

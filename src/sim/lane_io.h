@@ -3,8 +3,6 @@
 // (x, y, z, w), so four loads and a 4x4 transpose give four points' coordinates as lanes; wider
 // lanes are built from groups of four (concat) and taken apart the same way (split).
 
-#include <immintrin.h>
-
 #include <cstring>
 #include <utility>
 
@@ -49,6 +47,20 @@ void split(T v, Lane4* part) {
   }
 }
 
+/// Four floats at f (no alignment needed), and back.
+inline Lane4 load4(const float* f) {
+  Lane4 v;
+  std::memcpy(&v, f, sizeof v);
+  return v;
+}
+inline void store4(float* f, Lane4 v) { std::memcpy(f, &v, sizeof v); }
+
+/// Lanes I0..I3 of a and b together (0-3: a's lanes, 4-7: b's): _mm_shuffle_ps's job on any CPU.
+template <int I0, int I1, int I2, int I3>
+Lane4 shuffle4(Lane4 a, Lane4 b) {
+  return __builtin_shufflevector(a, b, I0, I1, I2, I3);
+}
+
 // A Point's four floats (x, y, z, w). Not Eigen's data(): the lane code calls no inline function
 // that other translation units also emit (lane_sweeps.h).
 inline const float* floats(const Point* p) { return reinterpret_cast<const float*>(p); }
@@ -84,7 +96,7 @@ void loadPoints(const Point* pts, const Index* idx, std::size_t stride, V3<T>& x
   T r[4];
   for (std::size_t k = 0; k < 4; ++k) {
     Lane4 part[kGroups<T>];
-    for (std::size_t g = 0; g < kGroups<T>; ++g) part[g] = _mm_load_ps(floats(pts + idx[(4 * g + k) * stride]));
+    for (std::size_t g = 0; g < kGroups<T>; ++g) part[g] = load4(floats(pts + idx[(4 * g + k) * stride]));
     r[k] = concat<T>(part);
   }
   transposeGroups(r);
@@ -103,7 +115,7 @@ void storePoints(Point* pts, const Index* idx, std::size_t stride, const V3<T>& 
     Lane4 part[kGroups<T>];
     split(r[k], part);
     for (std::size_t g = 0; g < kGroups<T>; ++g)
-      if (4 * g + k < count) _mm_store_ps(floats(pts + idx[(4 * g + k) * stride]), part[g]);
+      if (4 * g + k < count) store4(floats(pts + idx[(4 * g + k) * stride]), part[g]);
   }
 }
 
@@ -130,13 +142,17 @@ std::pair<T, T> fieldPairOf(const C* c, float C::*field) {
     const float* f = &(c[0].*field);
     return {f[0], f[1]};
   } else {
+    using Pairs = double __attribute__((vector_size(16)));  // two 8-byte pairs of floats
     Lane4 first[kGroups<T>], second[kGroups<T>];
     for (std::size_t g = 0; g < kGroups<T>; ++g) {
-      const auto pair = [&](std::size_t l) { return reinterpret_cast<const __m64*>(&(c[4 * g + l].*field)); };
-      const __m128 low = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(0)), pair(1));   // f0 s0 f1 s1
-      const __m128 high = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(2)), pair(3));  // f2 s2 f3 s3
-      first[g] = _mm_shuffle_ps(low, high, _MM_SHUFFLE(2, 0, 2, 0));
-      second[g] = _mm_shuffle_ps(low, high, _MM_SHUFFLE(3, 1, 3, 1));
+      const auto pair = [&](std::size_t l) {
+        double bytes;
+        std::memcpy(&bytes, &(c[4 * g + l].*field), sizeof bytes);
+        return bytes;
+      };
+      const Lane4 low = Lane4(Pairs{pair(0), pair(1)}), high = Lane4(Pairs{pair(2), pair(3)});  // f0 s0 f1 s1, f2 s2 f3 s3
+      first[g] = shuffle4<0, 2, 4, 6>(low, high);
+      second[g] = shuffle4<1, 3, 5, 7>(low, high);
     }
     return {concat<T>(first), concat<T>(second)};
   }
@@ -150,11 +166,10 @@ V3<T> loadVec3s(const Vec3* v) {
   Lane4 x[kGroups<T>], y[kGroups<T>], z[kGroups<T>];
   for (std::size_t g = 0; g < kGroups<T>; ++g) {
     const float* f = reinterpret_cast<const float*>(v + 4 * g);
-    const __m128 a = _mm_loadu_ps(f), b = _mm_loadu_ps(f + 4), c = _mm_loadu_ps(f + 8);  // x0y0z0x1 y1z1x2y2 z2x3y3z3
-    x[g] = _mm_shuffle_ps(a, _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2)), _MM_SHUFFLE(2, 0, 3, 0));
-    y[g] = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1)), _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 3)),
-                          _MM_SHUFFLE(2, 0, 2, 0));
-    z[g] = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2)), c, _MM_SHUFFLE(3, 0, 2, 0));
+    const Lane4 a = load4(f), b = load4(f + 4), c = load4(f + 8);  // x0y0z0x1 y1z1x2y2 z2x3y3z3
+    x[g] = shuffle4<0, 3, 4, 6>(a, shuffle4<2, 2, 5, 5>(b, c));
+    y[g] = shuffle4<0, 2, 4, 6>(shuffle4<1, 1, 4, 4>(a, b), shuffle4<3, 3, 6, 6>(b, c));
+    z[g] = shuffle4<0, 2, 4, 7>(shuffle4<2, 2, 5, 5>(a, b), c);
   }
   return {concat<T>(x), concat<T>(y), concat<T>(z)};
 }
@@ -165,15 +180,10 @@ void storeVec3s(Vec3* v, const V3<T>& lanes) {
   for (std::size_t g = 0; g < kGroups<T>; ++g) {
     float* f = reinterpret_cast<float*>(v + 4 * g);
     // Each output takes two pairs, each pair from a shuffle that holds it in lanes 0 and 2.
-    const auto pairs = [](__m128 first, __m128 second) {
-      return _mm_shuffle_ps(first, second, _MM_SHUFFLE(2, 0, 2, 0));
-    };
-    _mm_storeu_ps(f, pairs(_mm_shuffle_ps(x[g], y[g], _MM_SHUFFLE(0, 0, 0, 0)),
-                           _mm_shuffle_ps(z[g], x[g], _MM_SHUFFLE(1, 1, 0, 0))));  // x0 y0 z0 x1
-    _mm_storeu_ps(f + 4, pairs(_mm_shuffle_ps(y[g], z[g], _MM_SHUFFLE(1, 1, 1, 1)),
-                               _mm_shuffle_ps(x[g], y[g], _MM_SHUFFLE(2, 2, 2, 2))));  // y1 z1 x2 y2
-    _mm_storeu_ps(f + 8, pairs(_mm_shuffle_ps(z[g], x[g], _MM_SHUFFLE(3, 3, 2, 2)),
-                               _mm_shuffle_ps(y[g], z[g], _MM_SHUFFLE(3, 3, 3, 3))));  // z2 x3 y3 z3
+    const auto pairs = [](Lane4 first, Lane4 second) { return shuffle4<0, 2, 4, 6>(first, second); };
+    store4(f, pairs(shuffle4<0, 0, 4, 4>(x[g], y[g]), shuffle4<0, 0, 5, 5>(z[g], x[g])));      // x0 y0 z0 x1
+    store4(f + 4, pairs(shuffle4<1, 1, 5, 5>(y[g], z[g]), shuffle4<2, 2, 6, 6>(x[g], y[g])));  // y1 z1 x2 y2
+    store4(f + 8, pairs(shuffle4<2, 2, 7, 7>(z[g], x[g]), shuffle4<3, 3, 7, 7>(y[g], z[g])));  // z2 x3 y3 z3
   }
 }
 

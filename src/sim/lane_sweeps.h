@@ -2,7 +2,7 @@
 // The sweeps (sweeps.h) of one width behind plain function pointers, so that the world picks the
 // widest lanes the CPU has at run time (SolverSettings::simd). Each width is compiled in its own
 // translation unit with its instruction set's flags (sweeps_sse.cpp: float and Lane4 with the
-// default flags; sweeps_avx2.cpp: Lane8; sweeps_avx512.cpp: Lane16), and each of those
+// default flags; x86/sweeps_avx2.cpp: Lane8; x86/sweeps_avx512.cpp: Lane16, on x86-64 only), and each of those
 // instantiates the sweeps for its own lane type only: a template instantiated in two of them with
 // different flags could be merged by the linker into the one that needs the newer CPU.
 
@@ -75,8 +75,8 @@ LaneSweeps makeLaneSweeps() {
 
 const LaneSweeps& scalarSweeps();  ///< one at a time (sweeps_sse.cpp)
 const LaneSweeps& sseSweeps();     ///< 4 lanes (sweeps_sse.cpp)
-const LaneSweeps& avx2Sweeps();    ///< 8 lanes (sweeps_avx2.cpp); only where cpuSupports(SimdLevel::Avx2)
-const LaneSweeps& avx512Sweeps();  ///< 16 lanes (sweeps_avx512.cpp); only where cpuSupports(SimdLevel::Avx512)
+const LaneSweeps& avx2Sweeps();    ///< 8 lanes (x86/sweeps_avx2.cpp); only where cpuSupports(SimdLevel::Avx2)
+const LaneSweeps& avx512Sweeps();  ///< 16 lanes (x86/sweeps_avx512.cpp); only where cpuSupports(SimdLevel::Avx512)
 
 /// The lane widths for `level`, widest first (SimdLevel::Off: one at a time). A colour runs in
 /// whole batches of the widest and ends with one partial batch of the narrowest that holds the rest.

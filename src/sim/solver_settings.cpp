@@ -10,10 +10,16 @@ namespace vrd {
 
 bool cpuSupports(SimdLevel level) {
   switch (level) {
+#ifdef VRDEFORM_X86_LANES
     case SimdLevel::Avx2:
       return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
     case SimdLevel::Avx512:
       return __builtin_cpu_supports("avx512f");
+#else
+    case SimdLevel::Avx2:
+    case SimdLevel::Avx512:
+      return false;  // x86-64 only
+#endif
     default:
       return true;
   }

@@ -1,31 +1,61 @@
 #pragma once
-// The threads that solve one substep together (SolverSettings::threads): an OpenMP team, each
-// member running the same sweep and taking its share of the work (sweepColours in world.cpp: a
-// group of a big body's constraints, or a share of every colour), with barriers between the parts
-// that may touch the same particles. What runs at once shares no particle, so the result is bit for
-// bit the one-thread result.
+// The threads that solve one step together (SolverSettings::threads): each member runs the same
+// code and takes its share of the work (sweepColours in world.cpp: a group of a big body's
+// constraints, or a share of every colour), with barriers between the parts that may touch the
+// same particles. What runs at once shares no particle, so the result is bit for bit the
+// one-thread result.
+//
+// Waiting (at a barrier, or for the next step) spins briefly, since a partner is usually a few
+// microseconds away, then sleeps in the kernel: on a machine busier than its cores a descheduled
+// partner then costs a wake-up instead of a core spinning for a whole time slice, and an idle
+// team uses no CPU. Everything is synchronised through std::atomic, which ThreadSanitizer sees.
 
-#include <omp.h>
-
+#include <atomic>
 #include <cstddef>
+#include <cstdint>
+#include <thread>
+#include <type_traits>
 #include <utility>
+#include <vector>
 
 namespace vrd {
 
+/// Waits until `value` differs from `old` (acquiring what was released with the change).
+void waitForChange(const std::atomic<std::uint32_t>& value, std::uint32_t old);
+
+/// A reusable barrier for a fixed number of threads.
+class TeamBarrier {
+ public:
+  explicit TeamBarrier(int size) : size_(size) {}
+  /// Returns once all `size` threads have arrived; what each did before arriving is visible to all after.
+  void arriveAndWait() {
+    const std::uint32_t generation = generation_.load(std::memory_order_relaxed);
+    if (arrived_.fetch_add(1, std::memory_order_acq_rel) + 1 == size_) {
+      arrived_.store(0, std::memory_order_relaxed);  // published by the release below
+      generation_.store(generation + 1, std::memory_order_release);
+      generation_.notify_all();
+      return;
+    }
+    waitForChange(generation_, generation);
+  }
+
+ private:
+  int size_;
+  std::atomic<int> arrived_{0};
+  std::atomic<std::uint32_t> generation_{0};
+};
+
+/// One member's view of the team inside ThreadTeam::run (or a team of one, default-constructed).
 struct SolverTeam {
   int index = 0;  ///< this thread's place in the team
   int size = 1;   ///< threads in the team
-
-  /// The team of the enclosing OpenMP parallel region (or a team of one outside any).
-  static SolverTeam current() { return {omp_get_thread_num(), omp_get_num_threads()}; }
+  TeamBarrier* barrier_ = nullptr;
 
   bool leader() const { return index == 0; }
   bool last() const { return index + 1 == size; }
   /// Waits until every member has reached it; nothing in a team of one.
   void barrier() const {
-    if (size > 1) {
-#pragma omp barrier
-    }
+    if (size > 1) barrier_->arriveAndWait();
   }
   /// This member's share of [begin, end), cut at multiples of `align` from begin so that SIMD
   /// batches stay whole.
@@ -34,6 +64,38 @@ struct SolverTeam {
     const auto cut = [&](int k) { return std::min(end, begin + blocks * std::size_t(k) / std::size_t(size) * align); };
     return {cut(index), cut(index + 1)};
   }
+};
+
+/// `size` threads: the caller of run() and size - 1 workers that live as long as the team and
+/// sleep between runs.
+class ThreadTeam {
+ public:
+  explicit ThreadTeam(int size);
+  ~ThreadTeam();
+  ThreadTeam(const ThreadTeam&) = delete;
+  ThreadTeam& operator=(const ThreadTeam&) = delete;
+
+  int size() const { return size_; }
+
+  /// Runs job(member) on every member, the caller being the leader (index 0), and returns when all
+  /// have finished. `job` must not throw.
+  template <typename Job>
+  void run(Job&& job) {
+    run(&job, [](void* f, const SolverTeam& team) { (*static_cast<std::remove_reference_t<Job>*>(f))(team); });
+  }
+
+ private:
+  using Invoke = void (*)(void*, const SolverTeam&);
+  void run(void* job, Invoke invoke);
+  void work(int index);
+
+  int size_;
+  TeamBarrier barrier_;
+  std::atomic<std::uint32_t> runs_{0};  // bumped to start a run; workers wait for it to change
+  bool stopping_ = false;               // read by workers after a change of runs_
+  void* job_ = nullptr;
+  Invoke invoke_ = nullptr;
+  std::vector<std::thread> workers_;
 };
 
 }  // namespace vrd

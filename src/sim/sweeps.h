@@ -172,10 +172,9 @@ void strainWeightsOf(const StrainConstraint* c, VecOf<T> (&a)[4]) {
       static_assert(sizeof(StrainConstraint) % sizeof(float) == 0 && sizeof(Mat3) == 9 * sizeof(float));
       for (int i = 0; i < 3; ++i) {
         const float* col = *m + 3 * i;
-        __m128 r0 = _mm_loadu_ps(col), r1 = _mm_loadu_ps(col + stride);
-        __m128 r2 = _mm_loadu_ps(col + 2 * stride), r3 = _mm_loadu_ps(col + 3 * stride);
-        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-        column[i][0][g] = r0, column[i][1][g] = r1, column[i][2][g] = r2;
+        Lane4 r[4] = {load4(col), load4(col + stride), load4(col + 2 * stride), load4(col + 3 * stride)};
+        transposeGroups(r);
+        column[i][0][g] = r[0], column[i][1][g] = r[1], column[i][2][g] = r[2];
       }
     }
     for (int k = 0; k < 3; ++k) a[k + 1] = {concat<T>(column[0][k]), concat<T>(column[1][k]), concat<T>(column[2][k])};

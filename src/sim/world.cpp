@@ -49,6 +49,11 @@ void clearMultipliers(Body& b, const SolverTeam& team = SolverTeam{}) {
 }  // namespace
 
 World::World(const SolverSettings& settings) { setSettings(settings); }
+World::TeamSlot::TeamSlot(const TeamSlot&) {}
+World::TeamSlot::TeamSlot(TeamSlot&&) noexcept = default;
+World::TeamSlot& World::TeamSlot::operator=(const TeamSlot&) { return *this; }
+World::TeamSlot& World::TeamSlot::operator=(TeamSlot&&) noexcept = default;
+World::TeamSlot::~TeamSlot() = default;
 
 void World::setSettings(const SolverSettings& settings) {
   validateSolverSettings(settings);
@@ -221,10 +226,11 @@ void World::step() {
     return b.state == BodyState::Active && !(b.model->tetGroups.empty() && b.model->distanceGroups.empty());
   });
   if (settings_.threads > 1 && cut) {
+    std::unique_ptr<ThreadTeam>& team = team_.team;
+    if (!team || team->size() != settings_.threads) team = std::make_unique<ThreadTeam>(settings_.threads);
     memberContacts_.resize(std::size_t(settings_.threads));
     memberFinite_.resize(std::size_t(settings_.threads) * bodies_.size());
-#pragma omp parallel num_threads(settings_.threads)
-    substeps(SolverTeam::current());
+    team->run([this](const SolverTeam& member) { substeps(member); });
   } else {
     memberFinite_.resize(bodies_.size());
     substeps(SolverTeam{});

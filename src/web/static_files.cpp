@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "io/installed_data.h"
+#include "vrdeform/core/installed_data.h"
 #include "vrdeform/error.h"
 
 namespace vrd {

@@ -9,7 +9,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
-#include "io/json_depth.h"
+#include "vrdeform/core/json_depth.h"
 #include "vrdeform/devices/haptic_output.h"
 #include "vrdeform/error.h"
 

@@ -1,18 +1,21 @@
 #pragma once
 // One maths, every width: a 3-vector over a scalar type T that is float (the scalar solver),
-// double (derivative checks) or a lane type: Lane4 (SSE, every x86-64), Lane8 (AVX2) or Lane16
-// (AVX-512), that many constraints at once. Constraint kernels written over V3<T> run unchanged at
-// every width, so the scalar and SIMD paths cannot drift apart. The member names follow Eigen's so
-// that the same kernels also accept Eigen vectors. Lane8 and Lane16 exist only in translation
-// units compiled for their instruction set (src/sim/sweeps_avx*.cpp), chosen at run time.
+// double (derivative checks) or a lane type: Lane4 (4 lanes: SSE on x86-64, NEON on aarch64),
+// Lane8 (AVX2) or Lane16 (AVX-512), that many constraints at once. Constraint kernels written over
+// V3<T> run unchanged at every width, so the scalar and SIMD paths cannot drift apart. The member
+// names follow Eigen's so that the same kernels also accept Eigen vectors. The lanes are the
+// compiler's generic vectors (GCC and Clang), so this header holds no instruction set's
+// intrinsics; Lane8 and Lane16 exist only in translation units compiled for their instruction
+// set (src/sim/x86/sweeps_avx*.cpp), chosen at run time.
 
-#include <immintrin.h>
 #include <cmath>
 #include <cstddef>
+#include <type_traits>
+#include <utility>
 
 namespace vrd {
 
-/// Four floats processed together (GCC/Clang vector extension; SSE on any x86-64).
+/// Four floats processed together (GCC/Clang vector extension; SSE or NEON registers).
 using Lane4 = float __attribute__((vector_size(16)));
 #ifdef __AVX2__
 using Lane8 = float __attribute__((vector_size(32)));  ///< eight floats (AVX2)
@@ -25,46 +28,46 @@ using Lane16 = float __attribute__((vector_size(64)));  ///< sixteen floats (AVX
 template <typename T>
 inline constexpr std::size_t kWidth = sizeof(T) / sizeof(float);
 
+/// v in every lane of T.
 template <typename T>
 T splat(double v) {
-  return T(v);
+  if constexpr (std::is_floating_point_v<T>)
+    return T(v);
+  else
+    return T{} + float(v);
 }
-template <>
-inline Lane4 splat<Lane4>(double v) {
-  return Lane4{} + float(v);
-}
-#ifdef __AVX2__
-template <>
-inline Lane8 splat<Lane8>(double v) {
-  return Lane8{} + float(v);
-}
-#endif
-#ifdef __AVX512F__
-template <>
-inline Lane16 splat<Lane16>(double v) {
-  return Lane16{} + float(v);
-}
-#endif
 
-/// Per-lane choice: `mask ? a : b` (mask is a bool for scalars and a lane mask for Lane4).
+/// Per-lane choice: `mask ? a : b` (mask is a bool for scalars and a lane mask for lanes).
 template <typename M, typename T>
 T select(M mask, T a, T b) {
   return mask ? a : b;
 }
 
+/// f applied to each lane of v (the compiler turns a lane-wise sqrt into one vector instruction).
+template <typename T, typename F>
+T lanewise(T v, F f) {
+  return [&]<std::size_t... L>(std::index_sequence<L...>) { return T{f(v[L])...}; }
+  (std::make_index_sequence<kWidth<T>>{});
+}
+
 inline float sqrt(float v) { return std::sqrt(v); }
 inline double sqrt(double v) { return std::sqrt(v); }
-inline Lane4 sqrt(Lane4 v) { return _mm_sqrt_ps(v); }
+inline Lane4 sqrt(Lane4 v) {
+  return lanewise(v, [](float x) { return std::sqrt(x); });
+}
 #ifdef __AVX2__
-inline Lane8 sqrt(Lane8 v) { return _mm256_sqrt_ps(v); }
+inline Lane8 sqrt(Lane8 v) {
+  return lanewise(v, [](float x) { return std::sqrt(x); });
+}
 #endif
 #ifdef __AVX512F__
 inline Lane16 sqrt(Lane16 v) {
-  return _mm512_maskz_sqrt_ps(0xFFFF, v);
-}  // _mm512_sqrt_ps trips -Wuninitialized in GCC 12
+  return lanewise(v, [](float x) { return std::sqrt(x); });
+}
 #endif
 
-/// atan2 per lane to within 1 ulp (SLEEF, in each width's translation unit: src/sim/sweeps_*.cpp).
+/// atan2 per lane to within 1 ulp (SLEEF on x86-64, in each width's translation unit:
+/// src/sim/sweeps_sse.cpp, src/sim/x86/sweeps_avx*.cpp; the C library's lane by lane elsewhere).
 inline float atan2(float y, float x) { return std::atan2(y, x); }
 inline double atan2(double y, double x) { return std::atan2(y, x); }
 Lane4 atan2(Lane4 y, Lane4 x);

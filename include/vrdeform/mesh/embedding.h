@@ -33,8 +33,8 @@ struct alignas(32) EmbeddingBlock {
 
 /// Which SIMD kernel Embedding::update runs.
 enum class EmbeddingSimd {
-  best,  ///< AVX2 + FMA (8 lanes) when the CPU has them, else SSE
-  sse,   ///< SSE (4 lanes) on every x86-64
+  best,  ///< AVX2 + FMA (8 lanes) when the CPU has them, else SSE (one vertex at a time off x86-64)
+  sse,   ///< SSE (4 lanes) on every x86-64 (one vertex at a time elsewhere)
 };
 
 /// Binds each vertex of a render surface to the tet containing it (or, for vertices outside the

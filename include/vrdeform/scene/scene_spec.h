@@ -12,7 +12,7 @@
 #include "vrdeform/interact/grasp.h"
 #include "vrdeform/interact/hand_actions.h"
 #include "vrdeform/interact/hand_rig.h"
-#include "vrdeform/mesh/tetrahedralise.h"
+#include "vrdeform/io/tetrahedralise.h"
 #include "vrdeform/sim/body_model.h"
 #include "vrdeform/sim/collider.h"
 #include "vrdeform/sim/solver_settings.h"

@@ -16,9 +16,9 @@ enum class NanPolicy : std::uint8_t {
 /// How many constraints of one colour the solver projects at once (constraint_colouring.h).
 enum class SimdLevel : std::uint8_t {
   Off,     ///< one at a time: the plain reference loops
-  Sse,     ///< 4 lanes (SSE, every x86-64)
-  Avx2,    ///< 8 lanes (AVX2 + FMA)
-  Avx512,  ///< 16 lanes (AVX-512F)
+  Sse,     ///< 4 lanes (SSE on every x86-64, NEON on aarch64)
+  Avx2,    ///< 8 lanes (AVX2 + FMA; x86-64 only)
+  Avx512,  ///< 16 lanes (AVX-512F; x86-64 only)
   Best,    ///< the widest this CPU has (checked at run time)
 };
 
@@ -40,7 +40,7 @@ struct SolverSettings {
   bool timeStages = true;  ///< record per-stage wall-clock times (a few dozen clock reads per step)
   /// Lanes for each colour's constraints: the same Gauss-Seidel sweep as Off, up to rounding.
   SimdLevel simd = SimdLevel::Best;
-  /// Solver threads (OpenMP): 2 sweep the halves of a big body at once, more share each colour;
+  /// Solver threads (src/sim/solver_team.h): 2 sweep the halves of a big body at once, more share each colour;
   /// the result does not depend on it. Worth it for bodies of several thousand tets: a world with
   /// no body of 4,096 or more constraints of one type runs on the calling thread alone, as does 1.
   int threads = 1;

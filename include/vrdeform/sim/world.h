@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,7 @@
 namespace vrd {
 
 struct SolverTeam;
+class ThreadTeam;
 namespace sweeps {
 struct LanePlan;
 }
@@ -185,6 +187,17 @@ class World {
   std::array<ShapeMatchSums, 4> shapeMatchSums_;
   StepReport report_;
   std::uint64_t stepCount_ = 0;
+  // The solver's threads, made at the first step that uses them; a copy of the world makes its own.
+  struct TeamSlot {
+    std::unique_ptr<ThreadTeam> team;
+    TeamSlot() = default;
+    TeamSlot(const TeamSlot&);
+    TeamSlot(TeamSlot&&) noexcept;
+    TeamSlot& operator=(const TeamSlot&);
+    TeamSlot& operator=(TeamSlot&&) noexcept;
+    ~TeamSlot();
+  };
+  TeamSlot team_;
 };
 
 }  // namespace vrd

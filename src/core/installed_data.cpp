@@ -1,4 +1,4 @@
-#include "io/installed_data.h"
+#include "vrdeform/core/installed_data.h"
 
 #include <unistd.h>
 

@@ -1,4 +1,4 @@
-#include "vrdeform/mesh/tetrahedralise.h"
+#include "vrdeform/io/tetrahedralise.h"
 
 #include <fmt/format.h>
 

@@ -1,5 +1,6 @@
 #pragma once
-// Small POSIX helpers shared by the device threads (internal).
+// Small POSIX helpers of the threads that talk to devices and sockets: a file descriptor that closes
+// itself, a pipe that wakes a thread out of poll(), and friends.
 
 #include <fcntl.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-#include "io/json_depth.h"
+#include "vrdeform/core/json_depth.h"
 
 namespace vrd {
 

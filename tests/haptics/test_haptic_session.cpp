@@ -14,7 +14,7 @@
 #include "vrdeform/interact/hand_script.h"
 #include "vrdeform/io/surface_io.h"
 #include "vrdeform/mesh/primitives.h"
-#include "vrdeform/mesh/tetrahedralise.h"
+#include "vrdeform/io/tetrahedralise.h"
 
 namespace vrd {
 namespace {

@@ -12,10 +12,10 @@
 #include <fstream>
 #include <thread>
 
-#include "io/atomic_file.h"
+#include "vrdeform/core/atomic_file.h"
 #include "vrdeform/error.h"
 #include "vrdeform/io/tet_io.h"
-#include "vrdeform/mesh/tetrahedralise.h"
+#include "vrdeform/io/tetrahedralise.h"
 
 extern char** environ;
 

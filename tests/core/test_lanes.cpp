@@ -436,9 +436,6 @@ TEST(Lanes, ShapeMatchOfEveryWidthIsTheOneAtATimeShapeMatch) {
 // constraints run at once only when they touch disjoint particles, so the result is bit for bit
 // the one-thread result.
 TEST(Lanes, ThreadsGiveTheOneThreadResultExactly) {
-#if defined(__SANITIZE_THREAD__)
-  GTEST_SKIP() << "libgomp is not built for ThreadSanitizer; its barriers would be reported as races";
-#endif
   const auto small = dampedBlock(4, {true, true, true, true});  // 384 tets: not cut
   const auto big = dampedBlock(10, {true, true, true, true});   // 6,000: in groups
   ASSERT_EQ(small->tetGroups.size(), 0u);
@@ -461,9 +458,6 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactly) {
 // particles and one on its surface triangles, one corner held by an attachment; beside it a cloth
 // draping over a sphere, whose bending levels one member sweeps before the contacts.
 TEST(Lanes, ThreadsGiveTheOneThreadResultExactlyWithContacts) {
-#if defined(__SANITIZE_THREAD__)
-  GTEST_SKIP() << "libgomp is not built for ThreadSanitizer; its barriers would be reported as races";
-#endif
   const auto model = dampedBlock(10, {true, true, true, true});
   ASSERT_EQ(model->tetGroups.size(), 6u);
   const auto run = [&](int threads, std::size_t& contacts) {
@@ -508,9 +502,6 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactlyWithContacts) {
 // thread does, even where the leader holds none of the body's particles, and the other bodies go
 // on bit for bit.
 TEST(Lanes, ThreadsContainANonFiniteBodyAsOneThreadDoes) {
-#if defined(__SANITIZE_THREAD__)
-  GTEST_SKIP() << "libgomp is not built for ThreadSanitizer; its barriers would be reported as races";
-#endif
   const auto block = dampedBlock(10, {true, true, true, true});  // cut in groups: solved by the team
   const auto small = dampedBlock(2, {true, true, true, true});
   const auto run = [&](int threads) {

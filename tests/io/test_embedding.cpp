@@ -13,7 +13,7 @@
 #include "vrdeform/io/surface_io.h"
 #include "vrdeform/mesh/embedding.h"
 #include "vrdeform/mesh/primitives.h"
-#include "vrdeform/mesh/tetrahedralise.h"
+#include "vrdeform/io/tetrahedralise.h"
 #include "vrdeform/sim/particles.h"
 #include "vrdeform/sim/world.h"
 

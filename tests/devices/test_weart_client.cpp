@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "test_support.h"
-#include "vrdeform/devices/fake_middleware.h"
+#include "vrdeform/testing/fake_middleware.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/devices/weart_client.h"
 #include "vrdeform/haptics/haptic_session.h"
@@ -604,7 +604,9 @@ TEST(WeartClient, SurvivesGarbageFromTheMiddleware) {
   fake.sendRaw("\x80\xff\xfe\x01~");                          // not ASCII
   fake.sendRaw("CalibrationResult:7:0~force:abc~~~ ~\r\n~");  // bad hand; empty frames are not frames
   fake.sendRaw("SOMETHING_NEW:1:2~");                         // unknown ID: ignored, not malformed
-  fake.sendRaw(std::string((1 << 20) + 100, 'a') + "~");      // over-long: dropped by the splitter
+  std::string overLong((1 << 20) + 100, 'a');
+  overLong += '~';  // (appended, not added: GCC 12 warns about std::string + "~" here, wrongly)
+  fake.sendRaw(overLong);  // over-long: dropped by the splitter
   MiddlewareStatus status;
   status.status = "RUNNING";
   status.version = "9.9.9-split";

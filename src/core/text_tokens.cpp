@@ -1,4 +1,4 @@
-#include "io/text_tokens.h"
+#include "vrdeform/core/text_tokens.h"
 
 #include <fmt/format.h>
 

@@ -1,6 +1,6 @@
-#include "vrdeform/devices/fake_middleware.h"
+#include "vrdeform/testing/fake_middleware.h"
 
-#include "posix_fd.h"
+#include "vrdeform/core/posix_fd.h"
 
 #include <arpa/inet.h>
 #include <fcntl.h>

@@ -15,7 +15,7 @@
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/mesh/surface_check.h"
 #include "vrdeform/mesh/tet_quality.h"
-#include "vrdeform/mesh/tetrahedralise.h"
+#include "vrdeform/io/tetrahedralise.h"
 
 namespace vrd {
 namespace {

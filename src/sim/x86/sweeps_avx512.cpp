@@ -1,7 +1,7 @@
 // The 16-lane sweeps, compiled with -mavx512f (CMakeLists.txt); see lane_sweeps.h.
 #include <sleef.h>
 
-#include "lane_sweeps.h"
+#include "sim/lane_sweeps.h"
 
 namespace vrd {
 Lane16 atan2(Lane16 y, Lane16 x) { return Sleef_atan2f16_u10avx512f(y, x); }

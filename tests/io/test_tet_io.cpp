@@ -22,7 +22,7 @@
 #include "vrdeform/error.h"
 #include "vrdeform/io/tet_io.h"
 #include "vrdeform/io/vtu_sequence.h"
-#include "vrdeform/io/write_file.h"
+#include "vrdeform/core/write_file.h"
 #include "vrdeform/mesh/boundary.h"
 #include "vrdeform/mesh/primitives.h"
 

@@ -1,4 +1,4 @@
-#include "io/atomic_file.h"
+#include "vrdeform/core/atomic_file.h"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -6,7 +6,7 @@
 #include <system_error>
 
 #include "vrdeform/error.h"
-#include "vrdeform/io/write_file.h"
+#include "vrdeform/core/write_file.h"
 
 namespace vrd {
 
