@@ -12,9 +12,9 @@
 #include <string>
 #include <thread>
 
-#include "vrdeform/testing/fake_middleware.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
+#include "vrdeform/testing/fake_middleware.h"
 
 namespace {
 

@@ -9,10 +9,10 @@
 #include "vrdeform/error.h"
 #include "vrdeform/io/surface_io.h"
 #include "vrdeform/io/tet_io.h"
+#include "vrdeform/io/tetrahedralise.h"
 #include "vrdeform/mesh/boundary.h"
 #include "vrdeform/mesh/surface_check.h"
 #include "vrdeform/mesh/tet_quality.h"
-#include "vrdeform/io/tetrahedralise.h"
 
 namespace vrd {
 namespace {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "glove_link.h"
+#include "vrdeform/core/write_file.h"
 #include "vrdeform/devices/csv_recorder.h"
 #include "vrdeform/devices/osc_output.h"
 #include "vrdeform/devices/stop_signals.h"
@@ -31,7 +32,6 @@
 #include "vrdeform/interact/session_recording.h"
 #include "vrdeform/io/surface_io.h"
 #include "vrdeform/io/tet_io.h"
-#include "vrdeform/core/write_file.h"
 #include "vrdeform/scene/scene_builder.h"
 #include "vrdeform/sim/world.h"
 

@@ -5,8 +5,8 @@
 
 #include <system_error>
 
-#include "vrdeform/error.h"
 #include "vrdeform/core/write_file.h"
+#include "vrdeform/error.h"
 
 namespace vrd {
 

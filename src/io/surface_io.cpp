@@ -11,10 +11,10 @@
 #include <fstream>
 #include <unordered_map>
 
-#include "vrdeform/core/atomic_file.h"
 #include "io/binary.h"
 #include "io/extension.h"
 #include "io/ply_reader.h"
+#include "vrdeform/core/atomic_file.h"
 #include "vrdeform/error.h"
 
 namespace vrd {

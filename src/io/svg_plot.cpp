@@ -9,8 +9,8 @@
 #include <string_view>
 
 #include "io/xml_escape.h"
-#include "vrdeform/error.h"
 #include "vrdeform/core/write_file.h"
+#include "vrdeform/error.h"
 
 namespace vrd {
 namespace {

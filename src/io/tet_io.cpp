@@ -6,9 +6,9 @@
 #include <cctype>
 #include <limits>
 
-#include "vrdeform/core/atomic_file.h"
 #include "io/extension.h"
 #include "io/tet_formats.h"
+#include "vrdeform/core/atomic_file.h"
 #include "vrdeform/core/text_tokens.h"
 #include "vrdeform/error.h"
 

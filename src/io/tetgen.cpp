@@ -6,9 +6,9 @@
 #include <array>
 #include <cmath>
 
-#include "vrdeform/core/atomic_file.h"
 #include "io/tet_formats.h"
 #include "io/text_out.h"
+#include "vrdeform/core/atomic_file.h"
 #include "vrdeform/core/text_tokens.h"
 #include "vrdeform/error.h"
 #include "vrdeform/mesh/boundary.h"

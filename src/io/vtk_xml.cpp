@@ -18,8 +18,8 @@
 #include "io/binary.h"
 #include "io/tet_formats.h"
 #include "io/text_out.h"
-#include "vrdeform/core/text_tokens.h"
 #include "io/xml_escape.h"
+#include "vrdeform/core/text_tokens.h"
 #include "vrdeform/error.h"
 
 namespace vrd::io {

@@ -4,10 +4,10 @@
 
 #include <cmath>
 
-#include "vrdeform/core/atomic_file.h"
 #include "io/tet_formats.h"
 #include "io/text_out.h"
 #include "io/xml_escape.h"
+#include "vrdeform/core/atomic_file.h"
 #include "vrdeform/error.h"
 
 namespace vrd {

@@ -9,11 +9,11 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "vrdeform/core/write_file.h"
 #include "vrdeform/devices/csv_recorder.h"
 #include "vrdeform/error.h"
 #include "vrdeform/io/svg_plot.h"
 #include "vrdeform/io/vtu_sequence.h"
-#include "vrdeform/core/write_file.h"
 
 namespace vrd {
 namespace {

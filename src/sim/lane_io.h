@@ -150,7 +150,8 @@ std::pair<T, T> fieldPairOf(const C* c, float C::*field) {
         std::memcpy(&bytes, &(c[4 * g + l].*field), sizeof bytes);
         return bytes;
       };
-      const Lane4 low = Lane4(Pairs{pair(0), pair(1)}), high = Lane4(Pairs{pair(2), pair(3)});  // f0 s0 f1 s1, f2 s2 f3 s3
+      const Lane4 low = Lane4(Pairs{pair(0), pair(1)}),
+                  high = Lane4(Pairs{pair(2), pair(3)});  // f0 s0 f1 s1, f2 s2 f3 s3
       first[g] = shuffle4<0, 2, 4, 6>(low, high);
       second[g] = shuffle4<1, 3, 5, 7>(low, high);
     }

@@ -18,10 +18,10 @@
 #include <vector>
 
 #include "test_support.h"
-#include "vrdeform/testing/fake_middleware.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/devices/weart_client.h"
 #include "vrdeform/haptics/haptic_session.h"
+#include "vrdeform/testing/fake_middleware.h"
 
 namespace vrd::weart {
 
@@ -605,7 +605,7 @@ TEST(WeartClient, SurvivesGarbageFromTheMiddleware) {
   fake.sendRaw("CalibrationResult:7:0~force:abc~~~ ~\r\n~");  // bad hand; empty frames are not frames
   fake.sendRaw("SOMETHING_NEW:1:2~");                         // unknown ID: ignored, not malformed
   std::string overLong((1 << 20) + 100, 'a');
-  overLong += '~';  // (appended, not added: GCC 12 warns about std::string + "~" here, wrongly)
+  overLong += '~';         // (appended, not added: GCC 12 warns about std::string + "~" here, wrongly)
   fake.sendRaw(overLong);  // over-long: dropped by the splitter
   MiddlewareStatus status;
   status.status = "RUNNING";

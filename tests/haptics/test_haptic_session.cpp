@@ -13,8 +13,8 @@
 #include "vrdeform/haptics/haptic_session.h"
 #include "vrdeform/interact/hand_script.h"
 #include "vrdeform/io/surface_io.h"
-#include "vrdeform/mesh/primitives.h"
 #include "vrdeform/io/tetrahedralise.h"
+#include "vrdeform/mesh/primitives.h"
 
 namespace vrd {
 namespace {

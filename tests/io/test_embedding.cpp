@@ -11,9 +11,9 @@
 #include "test_support.h"
 #include "vrdeform/error.h"
 #include "vrdeform/io/surface_io.h"
+#include "vrdeform/io/tetrahedralise.h"
 #include "vrdeform/mesh/embedding.h"
 #include "vrdeform/mesh/primitives.h"
-#include "vrdeform/io/tetrahedralise.h"
 #include "vrdeform/sim/particles.h"
 #include "vrdeform/sim/world.h"
 

@@ -19,10 +19,10 @@
 #include <string>
 
 #include "test_support.h"
+#include "vrdeform/core/write_file.h"
 #include "vrdeform/error.h"
 #include "vrdeform/io/tet_io.h"
 #include "vrdeform/io/vtu_sequence.h"
-#include "vrdeform/core/write_file.h"
 #include "vrdeform/mesh/boundary.h"
 #include "vrdeform/mesh/primitives.h"
 

@@ -10,12 +10,12 @@
 
 #include "vrdeform/error.h"
 #include "vrdeform/io/surface_io.h"
+#include "vrdeform/io/tetrahedralise.h"
 #include "vrdeform/mesh/boundary.h"
 #include "vrdeform/mesh/isosurface_stuffing.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/mesh/surface_check.h"
 #include "vrdeform/mesh/tet_quality.h"
-#include "vrdeform/io/tetrahedralise.h"
 
 namespace vrd {
 namespace {
