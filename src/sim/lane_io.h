@@ -47,13 +47,12 @@ void split(T v, Lane4* part) {
   }
 }
 
-/// Four floats at f (no alignment needed), and back.
-inline Lane4 load4(const float* f) {
-  Lane4 v;
-  std::memcpy(&v, f, sizeof v);
-  return v;
-}
-inline void store4(float* f, Lane4 v) { std::memcpy(f, &v, sizeof v); }
+/// Four floats at f, and back: anywhere (load4, store4), or 16-byte aligned (a Point: loadPoint,
+/// storePoint). The types may alias the floats they read, as the x86 intrinsics' do.
+using UnalignedLane4 = float __attribute__((vector_size(16), aligned(4), may_alias));
+using AlignedLane4 = float __attribute__((vector_size(16), may_alias));
+inline Lane4 load4(const float* f) { return *reinterpret_cast<const UnalignedLane4*>(f); }
+inline void store4(float* f, Lane4 v) { *reinterpret_cast<UnalignedLane4*>(f) = v; }
 
 /// Lanes I0..I3 of a and b together (0-3: a's lanes, 4-7: b's): _mm_shuffle_ps's job on any CPU.
 template <int I0, int I1, int I2, int I3>
@@ -65,6 +64,8 @@ Lane4 shuffle4(Lane4 a, Lane4 b) {
 // that other translation units also emit (lane_sweeps.h).
 inline const float* floats(const Point* p) { return reinterpret_cast<const float*>(p); }
 inline float* floats(Point* p) { return reinterpret_cast<float*>(p); }
+inline Lane4 loadPoint(const Point* p) { return *reinterpret_cast<const AlignedLane4*>(p); }
+inline void storePoint(Point* p, Lane4 v) { *reinterpret_cast<AlignedLane4*>(p) = v; }
 
 /// Lane 4g + k of the result is lane 4g + P[k] of a for P[k] < 4 and lane 4g + P[k] - 4 of b
 /// otherwise: the same pattern in every group g of four lanes (one unpack or shufps per register).
@@ -96,7 +97,7 @@ void loadPoints(const Point* pts, const Index* idx, std::size_t stride, V3<T>& x
   T r[4];
   for (std::size_t k = 0; k < 4; ++k) {
     Lane4 part[kGroups<T>];
-    for (std::size_t g = 0; g < kGroups<T>; ++g) part[g] = load4(floats(pts + idx[(4 * g + k) * stride]));
+    for (std::size_t g = 0; g < kGroups<T>; ++g) part[g] = loadPoint(pts + idx[(4 * g + k) * stride]);
     r[k] = concat<T>(part);
   }
   transposeGroups(r);
@@ -115,7 +116,7 @@ void storePoints(Point* pts, const Index* idx, std::size_t stride, const V3<T>& 
     Lane4 part[kGroups<T>];
     split(r[k], part);
     for (std::size_t g = 0; g < kGroups<T>; ++g)
-      if (4 * g + k < count) store4(floats(pts + idx[(4 * g + k) * stride]), part[g]);
+      if (4 * g + k < count) storePoint(pts + idx[(4 * g + k) * stride], part[g]);
   }
 }
 
