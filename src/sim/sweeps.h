@@ -139,16 +139,25 @@ static_assert(offsetof(BendConstraint, compliance) == offsetof(BendConstraint, r
 static_assert(offsetof(StrainConstraint, shearCompliance) ==
               offsetof(StrainConstraint, stretchCompliance) + sizeof(float));
 
+// Each sweep below is one function with its kernels inlined, which saves the calls' cost, but not
+// under the sanitizers: instrumenting the flattened sweeps takes minutes to compile, and the
+// result is the same either way.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define VRD_SWEEP
+#else
+#define VRD_SWEEP [[gnu::flatten]]
+#endif
+
 template <typename T, bool Damped>
-[[gnu::flatten]] void distance(const DistanceConstraint* constraints, std::size_t begin, std::size_t end,
-                               float* lambdas, float tau, const Range& r) {
+VRD_SWEEP void distance(const DistanceConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
+                        float tau, const Range& r) {
   oneMultiplier<T, Damped, 2>(constraints, begin, end, lambdas, tau, r, &DistanceConstraint::restLength,
                               [](const auto&... a) { return solveDistance(a...); });
 }
 
 template <typename T, bool Damped>
-[[gnu::flatten]] void volume(const VolumeConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
-                             float tau, const Range& r) {
+VRD_SWEEP void volume(const VolumeConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
+                      float tau, const Range& r) {
   oneMultiplier<T, Damped, 4>(constraints, begin, end, lambdas, tau, r, &VolumeConstraint::restVolume,
                               [](const auto&... a) { return solveVolume(a...); });
 }
@@ -209,8 +218,8 @@ struct StrainLanes {
 // F of tets [begin, end) at the start of the substep, into Body::startDeformation (`out`): the damped
 // strain sweeps read it instead of the positions then.
 template <typename T>
-[[gnu::flatten]] void startDeformation(const StrainConstraint* constraints, std::size_t begin, std::size_t end,
-                                       float* out, std::size_t tets, const Range& r) {
+VRD_SWEEP void startDeformation(const StrainConstraint* constraints, std::size_t begin, std::size_t end, float* out,
+                                std::size_t tets, const Range& r) {
   const auto batch = [&](std::size_t first, std::size_t count, const StrainConstraint* c) {
     const Gathered<T, 4, false> g(c, count, r.start, r.start);
     VecOf<T> a[4], f[3];
@@ -223,8 +232,8 @@ template <typename T>
 }
 
 template <typename T, bool Damped>
-[[gnu::flatten]] void strain(const StrainConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
-                             std::size_t tets, const ConstraintDamping& damping, const Range& r) {
+VRD_SWEEP void strain(const StrainConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
+                      std::size_t tets, const ConstraintDamping& damping, const Range& r) {
   const auto batch = [&](std::size_t first, std::size_t count, const StrainConstraint* c) {
     Gathered<T, 4, false> g(c, count, r.pred, r.start);
     const StrainLanes<T> s(c, lambdas, tets, first, count, damping, r.invH, Damped ? r.startDeformation : nullptr);
@@ -238,9 +247,9 @@ template <typename T, bool Damped>
 
 // Strain and volume of the same tets in one pass (strain_volume.h): volume[j] belongs to strain[j].
 template <typename T, bool Damped>
-[[gnu::flatten]] void strainVolume(const StrainConstraint* strain, const VolumeConstraint* volume, std::size_t begin,
-                                   std::size_t end, float* strainLambdas, float* volumeLambdas, std::size_t tets,
-                                   const ConstraintDamping& damping, const Range& r) {
+VRD_SWEEP void strainVolume(const StrainConstraint* strain, const VolumeConstraint* volume, std::size_t begin,
+                            std::size_t end, float* strainLambdas, float* volumeLambdas, std::size_t tets,
+                            const ConstraintDamping& damping, const Range& r) {
   const auto batch = [&](std::size_t first, std::size_t count, const StrainConstraint* c, const VolumeConstraint* v) {
     Gathered<T, 4, false> g(c, count, r.pred, r.start);
     const StrainLanes<T> s(c, strainLambdas, tets, first, count, damping, r.invH,
@@ -260,8 +269,8 @@ template <typename T, bool Damped>
 // Bending, a level (BodyModel::bendLevels) at a time; flattened, as the other sweeps: evalBend and
 // projectScalar as calls took 29% more time one at a time.
 template <typename T, bool Damped>
-[[gnu::flatten]] void bend(const BendConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas,
-                           float tau, const Range& r) {
+VRD_SWEEP void bend(const BendConstraint* constraints, std::size_t begin, std::size_t end, float* lambdas, float tau,
+                    const Range& r) {
   oneMultiplier<T, Damped, 4>(constraints, begin, end, lambdas, tau, r, &BendConstraint::restAngle,
                               [](const auto&... a) { return solveBend(a...); });
 }
@@ -271,8 +280,8 @@ template <typename T, bool Damped>
 // lanes massless (forBatches); the lanes are added in a fixed order, so the sums depend only on
 // the range.
 template <typename T>
-[[gnu::flatten]] void shapeMatchSumsOf(const Point* p, const Vec3* q, const float* mass, std::size_t begin,
-                                       std::size_t end, ShapeMatchSums& out) {
+VRD_SWEEP void shapeMatchSumsOf(const Point* p, const Vec3* q, const float* mass, std::size_t begin, std::size_t end,
+                                ShapeMatchSums& out) {
   if constexpr (kWidth<T> == 1) {
     out = shapeMatchSums(p, q, mass, begin, end);
   } else {
@@ -308,8 +317,8 @@ template <typename T>
 // kWidth<T> consecutive particles at once and a last batch padded (as in forBatches), so that
 // every particle gets the same arithmetic in whichever batch and lane it falls.
 template <typename T>
-[[gnu::flatten]] void shapeMatchParticles(const Vec3* q, float compliance, const ShapeMatchFrame& frame, Vec3* lambda,
-                                          float tau, const Range& r, std::size_t begin, std::size_t end) {
+VRD_SWEEP void shapeMatchParticles(const Vec3* q, float compliance, const ShapeMatchFrame& frame, Vec3* lambda,
+                                   float tau, const Range& r, std::size_t begin, std::size_t end) {
   if constexpr (kWidth<T> == 1) {
     const XpbdCoefficients k = XpbdCoefficients::make(compliance, tau, r.invH);
     for (std::size_t i = begin; i < end; ++i) {
