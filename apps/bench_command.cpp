@@ -26,6 +26,7 @@ struct BenchArgs {
   bool json = false;
   int frames = 300;
   bool quick = false;                // skips the 100k-tet scaling row
+  bool smoke = false;                // every table at its smallest: checks the command, measures nothing
   SimdLevel simd = SimdLevel::Best;  // the lanes of every SIMD figure
 };
 
@@ -137,7 +138,8 @@ json table2(const BenchArgs& a, std::string& text) {
 json table3(const BenchArgs& a, std::string& text) {
   BuiltScene scene = buildScene(benchScene("liver", a));
   RunSettings run;
-  run.steps = std::uint64_t(std::llround(scene.spec.seconds / scene.spec.solver.timeStep));
+  run.steps =
+      a.smoke ? std::uint64_t(a.frames) : std::uint64_t(std::llround(scene.spec.seconds / scene.spec.solver.timeStep));
   const RunSummary r = runScene(scene, run);
   const SampleStats idle = r.latency.total(Phase::Idle), contact = r.latency.total(Phase::Contact);
   text += fmt::format("Table 3: per-stage latency of the liver scene with its poke and grasp, ms ({} frames)\n{}",
@@ -157,7 +159,7 @@ json table3(const BenchArgs& a, std::string& text) {
 // The liver's haptic loop in real time at 1 kHz for `seconds`, with a reader taking snapshots at
 // 90 Hz as a viewer would: with the scene's substeps, and with one (h = 1 ms).
 json loop(const BenchArgs& a, std::string& text) {
-  const double seconds = a.quick ? 0.5 : 2.0;
+  const double seconds = a.smoke ? 0.05 : a.quick ? 0.5 : 2.0;
   json rows = json::array();
   text +=
       fmt::format("Loop: the liver scene at 1 kHz in real time for {:g} s, a 90 Hz reader taking snapshots\n", seconds);
@@ -165,7 +167,12 @@ json loop(const BenchArgs& a, std::string& text) {
                       "steps", "achieved", "overruns", "resyncs", "p50 (ms)", "P99", "max");
   SceneSpec spec = benchScene("liver", a);
   spec.solver.timeStep = 1e-3f;
+  if (a.smoke) {  // at 1 kHz the settle and the calibration's poke take seconds
+    spec.settle = 0.05;
+    spec.haptics.calibrate = false;
+  }
   for (int substeps : {spec.solver.substeps, 1}) {
+    if (a.smoke && substeps != spec.solver.substeps) continue;
     spec.solver.substeps = substeps;
     BuiltScene scene = buildScene(spec);
     SimulationLoop loop(scene, {});
@@ -231,7 +238,7 @@ json scaling(const BenchArgs& a, std::string& text) {
       "step\n{:>8} | {:>10} {:>10} | {:>10} {:>10} | {:>8} {:>8}\n",
       "tets", "scalar 1t", "scalar 2t", fmt::format("{} 1t", lanes), fmt::format("{} 2t", lanes), "SIMD", "2 thr");
   for (int tets : {1000, 10000, 100000}) {
-    if (a.quick && tets > 10000) continue;
+    if ((a.quick && tets > 10000) || (a.smoke && tets > 1000)) continue;
     const TetMesh mesh = makeBoxTetsNear(Vec3::Zero(), Vec3(0.2f, 0.1f, 0.2f), tets);
     double ms[2][2] = {};  // [simd][threads - 1]
     std::size_t n = 0;
@@ -317,7 +324,7 @@ json targets(const BenchArgs& a, const json& table1Rows, std::string& text) {
     }
 
   // 10k tets, a whole haptic step at the loop's rate.
-  const int frames = std::max(60, a.frames);
+  const int frames = a.smoke ? a.frames : std::max(60, a.frames);
   const SampleStats one = pokedBlockSteps(a.simd, 1, frames), two = pokedBlockSteps(a.simd, 2, frames);
   text += fmt::format(
       "  10,368 tets pressed by a fingertip, full step (predict, contacts, solve, force): P99 {:.3f} ms on 2 threads "
@@ -414,6 +421,14 @@ std::function<int()> addBenchCommand(CLI::App& app) {
       ->check(CLI::Range(10, 100000))
       ->capture_default_str();
   cmd->add_flag("--quick", a->quick, "Leave out the 100k-tet scaling row; run the loop for 0.5 s instead of 2");
+  cmd->add_flag_callback(
+      "--smoke",
+      [a] {
+        a->smoke = a->quick = true;
+        a->frames = 2;
+      },
+      "Every table at its smallest (2 frames, the loop for 0.05 s, 1k tets): checks that the command runs, "
+      "measures nothing");
   cmd->add_option_function<std::string>(
          "--simd",
          [a](const std::string& name) {
