@@ -41,15 +41,21 @@ TEST(Rotation, WarmStartConvergesFasterThanColdStart) {
   for (int trial = 0; trial < 20; ++trial) {
     const Qd truth = randomRotation(rng);
     const Md A = truth.toRotationMatrix() * Eigen::Vector3d(1.2, 0.9, 1.05).asDiagonal();
-    Qd cold = Qd::Identity();
-    Qd warm = truth * Qd(Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()));  // last frame's answer, a bit off
-    const int coldSteps = extractRotation<double>(A, cold, 200);
-    const int warmSteps = extractRotation<double>(A, warm, 200);
+    const Qd coldStart = Qd::Identity();
+    const Qd warmStart =
+        truth * Qd(Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()));  // last frame's answer, a bit off
+    Qd cold = coldStart, warm = warmStart;
+    EXPECT_LT(extractRotation<double>(A, warm, 200), 200);
+    extractRotation<double>(A, cold, 200);
     EXPECT_LT(warm.angularDistance(truth), 1e-8);
     EXPECT_LT(cold.angularDistance(truth), 1e-8);
-    EXPECT_LT(warmSteps, 200);
+    // Closer after the same few steps. (Counting the steps to the 1e-12 tolerance would compare
+    // rounding noise near that floor, which differs between CPUs.)
     if (truth.angularDistance(Qd::Identity()) > 0.5) {
-      EXPECT_LT(warmSteps, coldSteps) << "trial " << trial;
+      Qd coldFew = coldStart, warmFew = warmStart;
+      extractRotation<double>(A, coldFew, 5);
+      extractRotation<double>(A, warmFew, 5);
+      EXPECT_LT(warmFew.angularDistance(truth), coldFew.angularDistance(truth)) << "trial " << trial;
     }
   }
 }

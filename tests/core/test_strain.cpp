@@ -30,11 +30,13 @@ TEST(Strain, ClosedFormKernelMatchesReference) {
       const auto fast = solveStrain(x, w, a, lambda, stretch, shear, d);
       const auto ref = solveStrainReference(x, w, invRest, lambda, stretch, shear, d);
       // Same algebra in a different order: float rounding of the O(1) quantities, ~1e-5 relative.
+      // A multiplier is a difference of such terms, so its error has a floor of about 1e-4 of
+      // them (2e-4: Eigen's products fuse multiply-adds on aarch64 and round differently).
       float scale = 1e-3f;
       for (int k = 0; k < 4; ++k) scale = std::max(scale, ref.dp[k].norm());
       for (int k = 0; k < 4; ++k) EXPECT_LT((fast.dp[k] - ref.dp[k]).norm(), 2e-4f * scale) << "trial " << trial;
       for (int c = 0; c < kStrainComponents; ++c)
-        EXPECT_NEAR(fast.dLambda[c], ref.dLambda[c], 2e-4f * (std::abs(ref.dLambda[c]) + 1e-4f)) << "trial " << trial;
+        EXPECT_NEAR(fast.dLambda[c], ref.dLambda[c], 2e-4f * (std::abs(ref.dLambda[c]) + 2e-4f)) << "trial " << trial;
       ++compared;
     }
   }
