@@ -83,6 +83,13 @@ void printSummary(const RunSummary& r, const BuiltScene& scene) {
     for (int f = 0; f < kFingerCount; ++f)
       if (r.fingers[f]) fmt::print(" {} {:.3f} ({:.3f} N);", fingerName(Finger(f)), r.forceMax[f], r.newtonsMax[f]);
     fmt::print(" hand (Algorithm 2) {:.3f}\n", r.paperMax);
+    for (const PokeSignal& p : r.pokes)
+      for (const auto& [channel, q, unit] : {std::tuple{"N", &p.newtons, " N"}, std::tuple{"normalised", &p.force, ""}})
+        fmt::print(
+            "  poke at {:.2f} s ({}, {}): roughness {:.2f}, loading Spearman {:.3f}, hold noise {:.1f}%, lag {} "
+            "steps, peak {:.3f}{}\n",
+            p.start, fingerName(p.finger), channel, q->roughness, q->loadingSpearman, 100 * q->holdNoise, q->lagSteps,
+            q->peak, unit);
   }
   fmt::print("  NaN events: {}\n", r.nanEvents);
   for (const std::string& e : r.events) fmt::print("    {}\n", e);

@@ -155,6 +155,33 @@ class RunFiles {
   std::vector<Vec3> positions_;
 };
 
+// A scripted poke's per-step samples, from its start to kPokeTail after its end.
+constexpr double kPokeTail = 0.3;
+struct PokeTrace {
+  const HandAction* poke;
+  std::vector<double> depth, newtons, force;
+  std::size_t holdBegin = 0, holdEnd = 0;
+
+  // Step k began at time t (the hand's schedule); its frame is done.
+  void add(double t, const HapticFrame& h, const HandRig& rig) {
+    if (t < poke->start || t >= poke->end() + kPokeTail) return;
+    const double hold = poke->start + poke->approach;
+    if (t < hold) holdBegin = depth.size() + 1;
+    if (t < hold + poke->hold) holdEnd = depth.size() + 1;
+    const float tipLow = rig.target(poke->finger).y() - rig.settings().geometry.fingertipRadius;
+    depth.push_back(poke->target.y() - tipLow);
+    newtons.push_back(h.fingers[int(poke->finger)].newtons);
+    force.push_back(h.fingers[int(poke->finger)].force);
+  }
+  bool complete(double dt) const {
+    return double(depth.size()) * dt >= poke->end() + kPokeTail - poke->start - 0.5 * dt;
+  }
+  PokeSignal signal() const {
+    return {poke->finger, poke->start, signalQuality(depth, newtons, holdBegin, holdEnd),
+            signalQuality(depth, force, holdBegin, holdEnd)};
+  }
+};
+
 // The poke under way at time t, if any.
 const HandAction* pokeAt(const std::vector<HandAction>& actions, double t) {
   for (const HandAction& a : actions)
@@ -179,6 +206,9 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
 
   std::unique_ptr<RunFiles> files;
   Traces traces;
+  std::vector<PokeTrace> pokes;
+  for (const HandAction& a : scene.actions)
+    if (a.kind == ActionKind::Poke) pokes.push_back(PokeTrace{&a, {}, {}, {}});
 
   HandInput* input = settings.input ? settings.input : scene.input.get();
   std::optional<HapticSession> session;
@@ -220,6 +250,8 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
         // Indentation only for the scene's own pokes (a glove's hand has no target).
         const bool scripted = input == scene.input.get();
         traces.add(t, h, session->rig(), scripted ? pokeAt(scene.actions, double(k) * summary.dt) : nullptr);
+        if (scripted)
+          for (PokeTrace& p : pokes) p.add(double(k) * summary.dt, h, session->rig());
       }
       if (files) files->step(scene, session ? &*session : nullptr, times, k, t, contact);
       if (settings.afterStep && !settings.afterStep(RunStep{k, t, session ? &*session : nullptr, loss})) break;
@@ -229,6 +261,8 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
     summary.error = e.what();
   }
   for (HapticOutput* out : settings.outputs) out->release();
+  for (const PokeTrace& p : pokes)
+    if (p.complete(summary.dt)) summary.pokes.push_back(p.signal());
   summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (files && summary.ok) {
     try {
@@ -272,6 +306,20 @@ std::string summaryJson(const RunSummary& s) {
   j["force_max"] = forceMax;
   j["newtons_max"] = newtonsMax;
   j["paper_force_max"] = number(s.paperMax);
+  const auto quality = [&](const SignalQuality& q) {
+    return json{{"roughness", number(q.roughness)},
+                {"loading_spearman", number(q.loadingSpearman)},
+                {"hold_noise", number(q.holdNoise)},
+                {"lag_steps", q.lagSteps},
+                {"peak", number(q.peak)}};
+  };
+  json pokes = json::array();
+  for (const PokeSignal& p : s.pokes)
+    pokes.push_back({{"finger", std::string(fingerName(p.finger))},
+                     {"start", p.start},
+                     {"newtons", quality(p.newtons)},
+                     {"force", quality(p.force)}});
+  j["pokes"] = pokes;
   json stages = json::object();
   const auto stats = [&](const SampleStats& st) {
     return json{{"mean", number(st.mean)}, {"p50", number(st.median)}, {"p95", number(st.p95)},

@@ -14,6 +14,7 @@
 
 #include "vrdeform/devices/haptic_output.h"
 #include "vrdeform/metrics/latency_stats.h"
+#include "vrdeform/metrics/signal_quality.h"
 #include "vrdeform/scene/scene_builder.h"
 
 namespace vrd {
@@ -35,6 +36,14 @@ struct RunSettings {
   std::function<bool(const RunStep&)> afterStep;
 };
 
+/// The signal of one of the scene's scripted pokes, from its start to 0.3 s after its release.
+struct PokeSignal {
+  Finger finger = Finger::Index;
+  double start = 0.0;     ///< s after settling
+  SignalQuality newtons;  ///< of the poking finger's force in newtons
+  SignalQuality force;    ///< of its normalised force (what the glove gets)
+};
+
 struct RunSummary {
   std::string scene;
   std::uint64_t steps = 0;
@@ -46,7 +55,8 @@ struct RunSummary {
   std::array<bool, kFingerCount> fingers{};  ///< the hand's fingers
   std::array<float, kFingerCount> forceMax{}, newtonsMax{};
   float paperMax = 0.0f;
-  std::uint64_t nanEvents = 0;  ///< bodies frozen or particles reset after a NaN
+  std::vector<PokeSignal> pokes;  ///< the scripted pokes that ran to their end
+  std::uint64_t nanEvents = 0;    ///< bodies frozen or particles reset after a NaN
   std::vector<std::string> events;
   LatencyRecorder latency;  ///< per step: idle (no finger touching, no grasp) or contact
   double wallSeconds = 0.0;
