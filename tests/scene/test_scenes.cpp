@@ -88,8 +88,22 @@ TEST_P(EveryBody, WholeRunGraspsAndKeepsItsVolume) {
   // Table 3's two states: the hand touches during the poke and the grasp, and is idle between.
   EXPECT_GE(r.latency.frames(Phase::Contact), grasped);
   EXPECT_GT(r.latency.frames(Phase::Idle), 60u);
+  // The scripted poke's signal: a force that starts and ends at 0 has roughness >= 1 (0.99: the
+  // smoothed value may still be decaying 0.3 s after the release).
+  ASSERT_EQ(r.pokes.size(), 1u);
+  const PokeSignal& poke = r.pokes[0];
+  EXPECT_EQ(poke.finger, Finger::Index);
+  for (const SignalQuality* q : {&poke.newtons, &poke.force}) {
+    EXPECT_GE(q->roughness, 0.99);
+    EXPECT_GT(q->loadingSpearman, 0.0);
+  }
+  EXPECT_GT(poke.newtons.peak, 0.0);
+  EXPECT_LE(poke.newtons.peak, r.newtonsMax[int(Finger::Index)]);
+  EXPECT_LE(poke.force.peak, r.forceMax[int(Finger::Index)]);
   testing::record("volume_loss_max", r.volumeLossMax);
   testing::record("grasped_steps", double(grasped));
+  testing::record("poke_roughness_newtons", poke.newtons.roughness);
+  testing::record("poke_roughness_normalised", poke.force.roughness);
 }
 
 INSTANTIATE_TEST_SUITE_P(Builtin, EveryBody, ::testing::Values("balloon", "bear", "furball", "jelly", "liver"));
@@ -114,8 +128,9 @@ TEST(SceneRun, WritesEveryOutputAndASummaryWithTheDocumentedKeys) {
   std::ifstream in(settings.outDir / "summary.json");
   const nlohmann::json j = nlohmann::json::parse(in);
   for (const char* key : {"scene", "steps", "dt", "tets", "particles", "constraints", "volume_loss_max",
-                          "volume_loss_final", "force_max", "stage_ms", "nan_events", "ok"})
+                          "volume_loss_final", "force_max", "stage_ms", "nan_events", "ok", "pokes"})
     EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_TRUE(j["pokes"].empty()) << "the poke was cut off at 2.5 s: no figures for half a press";
   EXPECT_EQ(j["scene"], "liver");
   EXPECT_EQ(j["steps"], 150);
   EXPECT_EQ(j["ok"], true);
