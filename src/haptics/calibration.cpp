@@ -70,6 +70,7 @@ HapticCalibration calibrateHaptics(const World& original, BodyId body, const Hap
   const float depth = settings.depth > 0.0f ? settings.depth : r;
   const Vec3 start = point - down * (1.5f * r), end = point + down * (depth - r);
   const FingertipId tip = world.addFingertip(start, r, 0.0f, settings.contact);
+  world.setFingertipFriction(tip, settings.friction);
   const Vec3 before = centroid(world, body);
 
   const int loading = std::max(1, int(std::lround(settings.duration / world.settings().timeStep)));

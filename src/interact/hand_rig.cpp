@@ -13,6 +13,7 @@ HandRig::HandRig(World& world, const HandRigSettings& settings, const HandFrame&
     if (!isFinite(targets_[f])) throw Error("hand: the initial frame puts a fingertip at a non-finite position");
     tips_[f] =
         world.addFingertip(targets_[f], settings.geometry.fingertipRadius, settings.compliance, settings.contact);
+    world.setFingertipFriction(*tips_[f], settings.friction);
   }
   if (!initial.direct) wrist_ = initial.pose.wrist;
 }

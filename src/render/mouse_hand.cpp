@@ -47,7 +47,7 @@ HandFrame MouseHand::update(const MouseState& mouse, const PosedScene& scene, co
           const Vec3 b = plus ? plus->point : Vec3(inside + radius_ * axis_);
           centre_ = 0.5f * (a + b);
           const float width = (b - a).dot(axis_);
-          open_ = width + 2.0f * radius_ + 0.01f;
+          open_ = width + 2.0f * radius_ + 0.02f;  // 2 cm clear: opening to it outdoes the grasp's hysteresis
           closed_ = std::max(width + 2.0f * radius_ * (1.0f - settings.pinchDepth), radius_);
           aperture_ = open_;
           grabbed_ = onViewPlane(ray, centre_, forward);

@@ -239,6 +239,7 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log) {
     CalibrationSettings c;
     c.radius = radius;
     c.contact = hand.rig.contact;
+    c.friction = hand.rig.friction;
     c.point = body->top;
     if (!hand.actions.empty()) {
       const ActionSpec& first = hand.actions.front();

@@ -601,8 +601,8 @@ HandSpec readHand(const Table& t, const std::vector<BodySpec>& bodies) {
                                                                {"triangles", FingertipContactMode::Triangles}};
   static constexpr Option<std::optional<GraspMode>> kGrasps[] = {
       {"local", GraspMode::Local}, {"paper", GraspMode::Paper}, {"off", std::nullopt}};
-  t.allowOnly({"enabled", "model", "contact", "fingertip_radius", "compliance", "grasp", "release_opening",
-               "closing_speed", "hold_reach", "hold_compliance", "script", "action"});
+  t.allowOnly({"enabled", "model", "contact", "fingertip_radius", "compliance", "static_friction", "dynamic_friction",
+               "grasp", "release_opening", "closing_speed", "hold_reach", "hold_compliance", "script", "action"});
 
   HandSpec hand;
   t.readBool("enabled", hand.enabled);
@@ -613,6 +613,8 @@ HandSpec readHand(const Table& t, const std::vector<BodySpec>& bodies) {
   t.readChoice("contact", hand.rig.contact, kContacts);
   t.readNumber("fingertip_radius", hand.rig.geometry.fingertipRadius, kPositive);
   t.readNumber("compliance", hand.rig.compliance, kNonNegative);
+  t.readNumber("static_friction", hand.rig.friction.staticFriction, kNonNegative);
+  t.readNumber("dynamic_friction", hand.rig.friction.dynamicFriction, kNonNegative);
 
   std::optional<GraspMode> grasp = hand.grasp.mode;
   t.readChoice("grasp", grasp, kGrasps);

@@ -167,7 +167,7 @@ FingertipId World::addFingertip(const Vec3& center, float radius, float complian
     throw Error(fmt::format("addFingertip: radius must be positive, got {}", radius));
   checkCompliance(compliance, "addFingertip");
   checkContactMode(mode, "addFingertip");
-  fingertips_.push_back({center, center, radius, compliance, true, mode});
+  fingertips_.push_back({center, center, radius, compliance, true, mode, {}, center});
   return FingertipId(fingertips_.size() - 1);
 }
 
@@ -183,6 +183,14 @@ void World::setFingertipContactMode(FingertipId id, FingertipContactMode mode) {
   fingertips_.at(id).mode = mode;
 }
 
+void World::setFingertipFriction(FingertipId id, const FingertipFriction& friction) {
+  if (!(std::isfinite(friction.staticFriction) && friction.staticFriction >= 0.0f &&
+        std::isfinite(friction.dynamicFriction) && friction.dynamicFriction >= 0.0f))
+    throw Error(fmt::format("setFingertipFriction: coefficients must be finite and >= 0, got {} and {}",
+                            friction.staticFriction, friction.dynamicFriction));
+  fingertips_.at(id).friction = friction;
+}
+
 Vec3 World::fingertipForce(FingertipId id) const {
   const float h = substepSize();
   Vec3 force = Vec3::Zero();
@@ -190,7 +198,8 @@ Vec3 World::fingertipForce(FingertipId id) const {
   for (std::size_t c = 0; c < fingertipContacts_.size(); ++c)
     if (fingertipContacts_[c].fingertip == id)
       force += fingertipLambda_[c] *
-               evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, f.center, f.radius).n;
+                   evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, f.center, f.radius).n +
+               fingertipFrictionLambda_[c];
   for (std::size_t c = 0; c < fingertipTriangleContacts_.size(); ++c)
     if (fingertipTriangleContacts_[c].fingertip == id)
       for (const Vec3& impulse : fingertipTriangleImpulse_[c]) force += impulse;
@@ -255,7 +264,10 @@ void World::substeps(const SolverTeam& team) {
       // Kinematic targets move linearly from where they were to their goals over the step.
       const float share = 1.0f / float(n - s);
       for (Attachment& a : attachments_) a.target += share * (a.goal - a.target);
-      for (Fingertip& f : fingertips_) f.center += share * (f.goal - f.center);
+      for (Fingertip& f : fingertips_) {
+        f.substepStart = f.center;
+        f.center += share * (f.goal - f.center);
+      }
     }
     predict(h, team);
     team.barrier();  // detection reads the fingertips' new centres
@@ -386,7 +398,9 @@ void World::resetMultipliers(const SolverTeam& team) {
   contactNormalLambda_.assign(colliderContacts_.size(), 0.0f);
   contactFrictionLambda_.assign(colliderContacts_.size(), Vec3::Zero());
   fingertipLambda_.assign(fingertipContacts_.size(), 0.0f);
+  fingertipFrictionLambda_.assign(fingertipContacts_.size(), Vec3::Zero());
   fingertipTriangleLambda_.assign(fingertipTriangleContacts_.size(), 0.0f);
+  fingertipTriangleFrictionLambda_.assign(fingertipTriangleContacts_.size(), Vec3::Zero());
   fingertipTriangleImpulse_.assign(fingertipTriangleContacts_.size(), {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
 }
 
@@ -632,6 +646,10 @@ void World::solveWorldConstraints(float invH, bool timed, const SolverTeam& team
                                                           XpbdCoefficients::make(f.compliance, 0.0f, invH));
       fingertipLambda_[c] += r.dLambda;
       q.pos += r.dp[0];
+      const Vec3 friction =
+          fingertipFriction(q, start[con.particle].pos, f, fingertipLambda_[c], fingertipFrictionLambda_[c]);
+      fingertipFrictionLambda_[c] += friction;
+      q.pos += q.w * friction;
     }
   }
   if (!fingertipTriangleContacts_.empty()) {
@@ -650,6 +668,15 @@ void World::solveWorldConstraints(float invH, bool timed, const SolverTeam& team
       q0.pos += r.dp[0];
       q1.pos += r.dp[1];
       q2.pos += r.dp[2];
+      const TriangleFriction friction =
+          fingertipTriangleFriction(q0, q1, q2, start[con.i[0]].pos, start[con.i[1]].pos, start[con.i[2]].pos, f,
+                                    fingertipTriangleLambda_[c], fingertipTriangleFrictionLambda_[c]);
+      fingertipTriangleFrictionLambda_[c] += friction.dLambda;
+      Point* corner[3] = {&q0, &q1, &q2};
+      for (int k = 0; k < 3; ++k) {
+        fingertipTriangleImpulse_[c][k] += friction.b[k] * friction.dLambda;
+        corner[k]->pos += corner[k]->w * friction.b[k] * friction.dLambda;
+      }
     }
   }
 }
@@ -795,8 +822,10 @@ std::vector<Vec3> World::particleConstraintForces(BodyId id) const {
   for (std::size_t c = 0; c < fingertipContacts_.size(); ++c)
     if (Vec3* fi = local(fingertipContacts_[c].particle)) {
       const Fingertip& tip = fingertips_[fingertipContacts_[c].fingertip];
-      *fi += fingertipLambda_[c] * invH2 *
-             evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, tip.center, tip.radius).n;
+      *fi += (fingertipLambda_[c] *
+                  evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, tip.center, tip.radius).n +
+              fingertipFrictionLambda_[c]) *
+             invH2;
     }
   for (std::size_t c = 0; c < fingertipTriangleContacts_.size(); ++c)
     for (int k = 0; k < 3; ++k)

@@ -63,6 +63,92 @@ TEST(Contact, DynamicFrictionGivesTheCoulombAcceleration) {
   EXPECT_LT(std::abs(v.dot(Vec3(-std::sin(theta), std::cos(theta), 0.0f))), 1e-4f);  // stays on the plane
 }
 
+// A particle resting on top of a fingertip with gravity tilted by theta from the contact's normal
+// (a sphere of 100 m, flat where it sits): the fingertip's friction acts as a collider's.
+struct OnFingertip {
+  World world;
+  FingertipId tip;
+  static constexpr float kRadius = 100.0f;
+
+  OnFingertip(float theta, FingertipFriction friction) {
+    SolverSettings s;
+    s.gravity = kG * Vec3(std::sin(theta), -std::cos(theta), 0.0f);  // downhill: +x
+    world.setSettings(s);
+    tip = world.addFingertip(Vec3::Zero(), kRadius);
+    world.setFingertipFriction(tip, friction);
+    world.addBody(singleParticle(Vec3(0.0f, kRadius, 0.0f)));
+  }
+  float downhill() const { return world.particles().x[0].pos.x(); }
+};
+
+TEST(Contact, FingertipFrictionHoldsBelowTheFrictionAngle) {
+  const float theta = 20.0f * std::numbers::pi_v<float> / 180.0f;  // tan 20 deg = 0.364 < mu_s = 0.5
+  OnFingertip on(theta, {0.5f, 0.3f});
+  for (int step = 0; step < 60; ++step) on.world.step();
+  EXPECT_LT(std::abs(on.downhill()), 1e-5f);
+  // The fingertip carries the weight, its friction the part along the surface: f_t / f_n = tan(theta).
+  const Vec3 f = on.world.fingertipForce(on.tip);
+  EXPECT_NEAR(std::abs(f.x() / f.y()), std::tan(theta), 2e-3f * std::tan(theta));
+}
+
+TEST(Contact, FingertipFrictionSlidesWithTheCoulombAcceleration) {
+  const float theta = 30.0f * std::numbers::pi_v<float> / 180.0f, muK = 0.3f;  // tan 30 deg = 0.577 > 0.5
+  OnFingertip on(theta, {0.5f, muK}), bare(theta, {});
+  for (int step = 0; step < 30; ++step) on.world.step(), bare.world.step();
+  // After 0.5 s, v = a t down the slope (exact in the discrete scheme): a = g (sin - mu_k cos), and
+  // g sin(theta) without friction, as on the paper's frictionless fingertips. The sphere turns by
+  // 0.006 rad under it: 1% at most.
+  const float a = kG * (std::sin(theta) - muK * std::cos(theta)), free = kG * std::sin(theta);
+  EXPECT_NEAR(on.world.particles().v[0].x(), 0.5f * a, 0.01f * 0.5f * a);
+  EXPECT_NEAR(bare.world.particles().v[0].x(), 0.5f * free, 0.01f * 0.5f * free);
+}
+
+// Triangle contacts: a fingertip pressed 2 mm into a block on frictionless ground, then moved 3 cm
+// sideways over a second. Its friction drags the block along; without friction it rides over the
+// shallow dent it makes.
+TEST(Contact, FingertipFrictionDragsTheSurfaceItPresses) {
+  const auto dragged = [](FingertipFriction friction) {
+    World world(testing::BlockOnGround::settings(1));
+    Material m;
+    m.elastic = ElasticModuli{2e4f, 0.3f, 1000.0f};
+    const BodyId body = world.addBody(makeSoftBody(
+        makeBoxTets(Vec3(-0.05f, 0.0f, -0.05f), Vec3::Constant(0.1f), 4, 4, 4), m, {false, true, true, false}));
+    Collider ground = Collider::plane(Vec3::UnitY());
+    ground.staticFriction = ground.dynamicFriction = 0.0f;
+    world.addCollider(ground);
+    const FingertipId tip = world.addFingertip(Vec3(0.0f, 0.2f, 0.0f), 0.03f, 0.0f, FingertipContactMode::Triangles);
+    world.setFingertipFriction(tip, friction);
+    const auto centre = [&] {
+      float x = 0.0f;
+      for (const Point& p : world.particles().x) x += p.pos.x();
+      return x / float(world.particles().x.size());
+    };
+    for (int step = 0; step < 60; ++step) world.step();  // settle
+    float top = 0.0f;
+    for (const Point& p : world.particles().x) top = std::max(top, p.pos.y());
+    const float y = top + 0.03f - 0.002f;
+    world.moveFingertip(tip, Vec3(0.0f, y, 0.0f));
+    for (int step = 0; step < 60; ++step) world.step();
+    const float before = centre();
+    for (int step = 1; step <= 60; ++step) {
+      world.moveFingertip(tip, Vec3(0.03f * float(step) / 60.0f, y, 0.0f));
+      world.step();
+    }
+    EXPECT_EQ(world.body(body).state, BodyState::Active);
+    return centre() - before;
+  };
+  EXPECT_GT(dragged({0.8f, 0.6f}), 0.015f);  // more than half the fingertip's travel (the block shears)
+  EXPECT_LT(std::abs(dragged({})), 0.005f);
+}
+
+TEST(Contact, FingertipFrictionIsValidated) {
+  World world;
+  const FingertipId tip = world.addFingertip(Vec3::Zero(), 0.01f);
+  for (const FingertipFriction bad : {FingertipFriction{-0.1f, 0.1f}, FingertipFriction{0.5f, std::nanf("")}})
+    EXPECT_NE(testing::errorOf([&] { world.setFingertipFriction(tip, bad); }).find("setFingertipFriction"),
+              std::string::npos);
+}
+
 TEST(Contact, CompliantGroundSinksByAlphaMG) {
   // C + alphaTilde lambda = 0 with lambda = m g h^2 at rest: depth = alpha m g.
   SolverSettings s;

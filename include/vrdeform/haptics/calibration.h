@@ -21,6 +21,7 @@ namespace vrd {
 struct CalibrationSettings {
   float radius = 0.009f;                                           ///< fingertip radius (m)
   FingertipContactMode contact = FingertipContactMode::Particles;  ///< as the hand that will use the result
+  FingertipFriction friction;                                      ///< as the hand that will use the result
   float depth = 0.0f;                                              ///< indentation (m); 0 = the radius
   float duration = 1.0f;                                           ///< loading time (s)
   float contactTarget = 1.0f;                                      ///< normalised contact multiplier at full depth

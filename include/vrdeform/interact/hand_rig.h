@@ -17,6 +17,7 @@ struct HandRigSettings {
   /// Particles: the paper's contacts (eqs. 36-39). Triangles: against the bodies' surface
   /// triangles, so a fingertip pressing between the vertices of a coarse mesh still touches.
   FingertipContactMode contact = FingertipContactMode::Particles;
+  FingertipFriction friction;  ///< of the fingertips' contacts (none: the paper's)
 
   static HandRigSettings g1() { return {}; }
   static HandRigSettings pro() {

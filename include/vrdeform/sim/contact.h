@@ -28,11 +28,25 @@ struct ContactCorrection {
   Vec3 dp;
 };
 
+/// Coulomb friction on accumulated multipliers (cf. SS19 eq. 12): the tangential part of `motion`
+/// (the contact point's motion in the substep relative to what it touches) is cancelled while the
+/// friction multiplier stays inside the static cone |lambda_t| <= mu_s lambda_n; outside it the
+/// multiplier is scaled onto the dynamic cone mu_k lambda_n. `inverseMass`: the contact point's
+/// (w for a particle, sum b_k^2 w_k for a triangle's point). Returns the multiplier's change; the
+/// point moves by inverseMass times it.
+inline Vec3 frictionDelta(const Vec3& motion, const Vec3& normal, float inverseMass, const Vec3& lambdaFriction,
+                          float lambdaNormal, float staticFriction, float dynamicFriction) {
+  if (lambdaNormal <= 0.0f || staticFriction <= 0.0f || !(inverseMass > 0.0f)) return Vec3::Zero();
+  const Vec3 tangential = motion - normal.dot(motion) * normal;
+  Vec3 friction = lambdaFriction - tangential / inverseMass;  // stick: cancel all tangential motion
+  const float magnitude = friction.norm();
+  if (magnitude > staticFriction * lambdaNormal) friction *= dynamicFriction * lambdaNormal / magnitude;
+  return friction - lambdaFriction;
+}
+
 /// Normal: C = d(p) - r >= 0 (d: signed distance, r: the particle's radius), projected with eq. 1
-/// and clamped so the accumulated lambda_n stays >= 0. Friction: the tangential motion since the
-/// start of the substep, p - x0, is cancelled while the friction multiplier stays inside the
-/// static cone |lambda_t| <= mu_s lambda_n; outside it the multiplier is scaled onto the dynamic
-/// cone mu_k lambda_n (Coulomb friction on accumulated multipliers, cf. SS19 eq. 12).
+/// and clamped so the accumulated lambda_n stays >= 0. Friction (frictionDelta): against the
+/// particle's motion since the start of the substep, p - x0.
 inline ContactCorrection solveColliderContact(const Point& p, const Vec3& x0, const SurfacePoint& surface,
                                               float particleRadius, const Collider& collider, float lambdaNormal,
                                               const Vec3& lambdaFriction, const XpbdCoefficients& k) {
@@ -42,14 +56,8 @@ inline ContactCorrection solveColliderContact(const Point& p, const Vec3& x0, co
   const float newNormal = std::max(lambdaNormal + deltaLambda(C, lambdaNormal, p.w, k), 0.0f);
   out.dLambdaNormal = newNormal - lambdaNormal;
   out.dp = p.w * out.dLambdaNormal * surface.normal;
-  if (newNormal <= 0.0f || collider.staticFriction <= 0.0f) return out;
-
-  const Vec3 motion = p.pos + out.dp - x0;
-  const Vec3 tangential = motion - surface.normal.dot(motion) * surface.normal;
-  Vec3 friction = lambdaFriction - tangential / p.w;  // stick: cancel all tangential motion
-  const float magnitude = friction.norm();
-  if (magnitude > collider.staticFriction * newNormal) friction *= collider.dynamicFriction * newNormal / magnitude;
-  out.dLambdaFriction = friction - lambdaFriction;
+  out.dLambdaFriction = frictionDelta(p.pos + out.dp - x0, surface.normal, p.w, lambdaFriction, newNormal,
+                                      collider.staticFriction, collider.dynamicFriction);
   out.dp += p.w * out.dLambdaFriction;
   return out;
 }
@@ -60,6 +68,14 @@ enum class FingertipContactMode : std::uint8_t {
   Triangles,  ///< the bodies' surface triangles (BodyModel::surface), so it also meets faces between vertices
 };
 
+/// Coulomb friction between a fingertip and what it touches (beyond the paper, whose contacts are
+/// frictionless): skin grips the surface it presses, so a poke on a slope holds the surface under
+/// the finger instead of pushing the body aside.
+struct FingertipFriction {
+  float staticFriction = 0.0f;   ///< mu_s: sticks while |f_t| <= mu_s f_n
+  float dynamicFriction = 0.0f;  ///< mu_k: sliding friction force = mu_k f_n
+};
+
 /// A fingertip: a kinematic sphere moved by the user (paper section 5.2).
 struct Fingertip {
   Vec3 center;          ///< p_finger in the current substep
@@ -68,6 +84,8 @@ struct Fingertip {
   float compliance;     ///< alpha of the contact constraints (m/N)
   bool enabled = true;  ///< a disabled fingertip makes no contacts (e.g. while it holds a grasp)
   FingertipContactMode mode = FingertipContactMode::Particles;  ///< particles (the paper) or surface triangles
+  FingertipFriction friction;                                   ///< none: the paper's frictionless contacts
+  Vec3 substepStart = center;  ///< the centre at the start of the current substep (friction's reference)
 };
 
 /// A particle in the contact set N(r) of a fingertip (eq. 36).
@@ -98,6 +116,16 @@ inline Correction<Vec3, 1> solveFingertipContact(const Point& p, const Vec3& cen
   const float newLambda = std::max(lambda + deltaLambda(e.C, lambda, p.w, k), 0.0f);
   const float dLambda = newLambda - lambda;
   return {dLambda, {p.w * dLambda * e.n}};
+}
+
+/// The fingertip's friction on a particle it pushes with lambdaNormal, after the normal
+/// projection (frictionDelta): against the particle's motion since the start of the substep (from
+/// x0) relative to the fingertip's. Returns the multiplier's change; the particle moves by w times it.
+inline Vec3 fingertipFriction(const Point& p, const Vec3& x0, const Fingertip& f, float lambdaNormal,
+                              const Vec3& lambdaFriction) {
+  const Vec3 n = evalSphereContact(p.pos, f.center, f.radius).n;
+  return frictionDelta(p.pos - x0 - (f.center - f.substepStart), n, p.w, lambdaFriction, lambdaNormal,
+                       f.friction.staticFriction, f.friction.dynamicFriction);
 }
 
 /// A surface triangle in the contact set of a fingertip in FingertipContactMode::Triangles.
@@ -214,6 +242,30 @@ inline TriangleContactCorrection solveFingertipTriangleContact(const Point& x0, 
     out.grad[c] = -e.b[c] * e.n;
     out.dp[c] = (w[c] * out.dLambda) * out.grad[c];
   }
+  return out;
+}
+
+struct TriangleFriction {
+  Vec3 dLambda = Vec3::Zero();  ///< the friction multiplier's change; corner k moves by w_k b_k times it
+  std::array<float, 3> b{};     ///< barycentric weights of the point under the fingertip
+};
+
+/// The fingertip's friction on a triangle it pushes with lambdaNormal, after the normal
+/// projection (frictionDelta): against the motion of the triangle's point under the fingertip
+/// (its barycentric weights now, applied to the corners x0 at the start of the substep) relative
+/// to the fingertip's, with that point's inverse mass sum_k b_k^2 w_k.
+inline TriangleFriction fingertipTriangleFriction(const Point& p0, const Point& p1, const Point& p2, const Vec3& x0,
+                                                  const Vec3& x1, const Vec3& x2, const Fingertip& f,
+                                                  float lambdaNormal, const Vec3& lambdaFriction) {
+  TriangleFriction out;
+  if (lambdaNormal <= 0.0f || f.friction.staticFriction <= 0.0f) return out;
+  const TriangleContactEval<float> e = evalFingertipTriangleContact(p0.pos, p1.pos, p2.pos, f.center, f.radius);
+  if (e.n.isZero()) return out;
+  out.b = e.b;
+  const Vec3 motion = e.b[0] * (p0.pos - x0) + e.b[1] * (p1.pos - x1) + e.b[2] * (p2.pos - x2);
+  const float inverseMass = e.b[0] * e.b[0] * p0.w + e.b[1] * e.b[1] * p1.w + e.b[2] * e.b[2] * p2.w;
+  out.dLambda = frictionDelta(motion - (f.center - f.substepStart), e.n, inverseMass, lambdaFriction, lambdaNormal,
+                              f.friction.staticFriction, f.friction.dynamicFriction);
   return out;
 }
 

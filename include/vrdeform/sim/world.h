@@ -95,10 +95,14 @@ class World {
   void setFingertipEnabled(FingertipId id, bool enabled);
   /// Switches what the fingertip touches; takes effect at the next substep.
   void setFingertipContactMode(FingertipId id, FingertipContactMode mode);
+  /// Coulomb friction of the fingertip's contacts (none by default, as in the paper); throws for a
+  /// negative or non-finite coefficient.
+  void setFingertipFriction(FingertipId id, const FingertipFriction& friction);
   const Fingertip& fingertip(FingertipId id) const { return fingertips_.at(id); }
   std::size_t fingertipCount() const { return fingertips_.size(); }
-  /// Total force the fingertip applied to the bodies in the last substep (N): lambda n / h^2 summed
-  /// over its particle contacts, and the impulse its triangle contacts applied, / h^2.
+  /// Total force the fingertip applied to the bodies in the last substep (N): (lambda n + friction
+  /// lambda_t) / h^2 summed over its particle contacts, and the impulse its triangle contacts
+  /// applied, / h^2.
   Vec3 fingertipForce(FingertipId id) const;
   /// Number of particles (or, in Triangles mode, surface triangles) the fingertip pushed in the
   /// last substep (contacts with lambda > 0).
@@ -170,8 +174,10 @@ class World {
   std::vector<Fingertip> fingertips_;
   std::vector<FingertipContact> fingertipContacts_;
   std::vector<float> fingertipLambda_;
+  std::vector<Vec3> fingertipFrictionLambda_;
   std::vector<FingertipTriangleContact> fingertipTriangleContacts_;
   std::vector<float> fingertipTriangleLambda_;
+  std::vector<Vec3> fingertipTriangleFrictionLambda_;
   std::vector<std::array<Vec3, 3>> fingertipTriangleImpulse_;  // per corner: sum of grad C dLambda this substep
   std::vector<SimEvent> events_;
   // A team's scratch: each member's contacts before the leader joins them (the leader's own go
