@@ -156,6 +156,52 @@ json table3(const BenchArgs& a, std::string& text) {
           {"paper", {{"idle_mean", kIdleTotal}, {"contact_mean", kContactTotal}, {"contact_p99", kContactP99}}}};
 }
 
+// What the poking finger feels (metrics/signal_quality.h): each tet scene's scripted poke with the
+// scene as it is, and with the previous defaults (frictionless fingertips, the paper's), side by
+// side. Runs until 0.3 s after the poke's release.
+json signalQualityTable(const BenchArgs& a, std::string& text) {
+  text += "Signal: the index finger during each scene's scripted poke (newtons | normalised)\n";
+  text +=
+      fmt::format("{:<9} {:<9} | {:>6} {:>8} {:>6} {:>4} {:>8} | {:>6} {:>8} {:>6} {:>4} {:>6}\n", "scene", "defaults",
+                  "rough", "Spearman", "noise", "lag", "peak N", "rough", "Spearman", "noise", "lag", "peak");
+  json rows = json::array();
+  const auto figures = [](const SignalQuality& q) {
+    return json{{"roughness", q.roughness},
+                {"loading_spearman", q.loadingSpearman},
+                {"hold_noise", q.holdNoise},
+                {"lag_steps", q.lagSteps},
+                {"peak", q.peak}};
+  };
+  for (const PaperRow& p : kTable1) {
+    if (a.smoke && std::string_view(p.scene) != "liver") continue;
+    for (const bool previous : {false, true}) {
+      SceneSpec spec = benchScene(p.scene, a);
+      if (previous) spec.hand.rig.friction = {};
+      double end = 0.0;
+      for (const ActionSpec& action : spec.hand.actions)
+        if (action.action.kind == ActionKind::Poke) end = action.action.end() + 0.3;
+      BuiltScene scene = buildScene(spec);
+      RunSettings run;
+      run.steps = std::uint64_t(std::ceil(end / spec.solver.timeStep));
+      const RunSummary r = runScene(scene, run);
+      if (r.pokes.empty()) continue;
+      const SignalQuality &n = r.pokes[0].newtons, &f = r.pokes[0].force;
+      text +=
+          fmt::format("{:<9} {:<9} | {:6.2f} {:8.3f} {:5.1f}% {:4} {:8.3f} | {:6.2f} {:8.3f} {:5.1f}% {:4} {:6.3f}\n",
+                      p.scene, previous ? "previous" : "now", n.roughness, n.loadingSpearman, 100 * n.holdNoise,
+                      n.lagSteps, n.peak, f.roughness, f.loadingSpearman, 100 * f.holdNoise, f.lagSteps, f.peak);
+      rows.push_back({{"scene", p.scene},
+                      {"defaults", previous ? "previous" : "now"},
+                      {"newtons", figures(n)},
+                      {"normalised", figures(f)}});
+    }
+  }
+  text +=
+      "  (roughness: total variation / 2 peak, 1 for one clean rise and fall; Spearman: force against depth while "
+      "loading; noise: sd / mean while holding; lag: steps behind the depth; previous: frictionless fingertips)\n\n";
+  return rows;
+}
+
 // The liver's haptic loop in real time at 1 kHz for `seconds`, with a reader taking snapshots at
 // 90 Hz as a viewer would: with the scene's substeps, and with one (h = 1 ms).
 json loop(const BenchArgs& a, std::string& text) {
@@ -401,6 +447,7 @@ int bench(const BenchArgs& a) {
   j["loop"] = loop(a, text);
   j["scaling"] = scaling(a, text);
   j["targets"] = targets(a, j["table1"], text);
+  j["signal"] = signalQualityTable(a, text);
   if (a.json)
     fmt::print("{}\n", j.dump(2));
   else
