@@ -24,8 +24,11 @@ struct CalibrationSettings {
   FingertipFriction friction;                                      ///< as the hand that will use the result
   float depth = 0.0f;                                              ///< indentation (m); 0 = the radius
   float duration = 1.0f;                                           ///< loading time (s)
-  float contactTarget = 1.0f;                                      ///< normalised contact multiplier at full depth
-  float volumeStrainTarget = 0.8f;                                 ///< F_VS at full depth
+  /// The standard poke's contact term (eq. 40) and F_VS (eq. 42): half of full scale, so the
+  /// contact term clips only at twice the standard poke's multipliers and a deeper press still
+  /// feels deeper (the standard poke reads 0.45 with the default betas).
+  float contactTarget = 0.5f;
+  float volumeStrainTarget = 0.4f;
   std::optional<Vec3> point;  ///< poke this surface point instead of the highest particle
 };
 
