@@ -91,7 +91,14 @@ void printSummary(const RunSummary& r, const BuiltScene& scene) {
             p.start, fingerName(p.finger), channel, q->roughness, q->loadingSpearman, 100 * q->holdNoise, q->lagSteps,
             q->peak, unit);
   }
-  fmt::print("  NaN events: {}\n", r.nanEvents);
+  fmt::print(
+      "  convergence (the last iteration's corrections / mean rest edge; RMS mean, max), {:.1f} iterations "
+      "a step:",
+      r.iterationsMean);
+  for (std::size_t s = 0; s < kStageCount; ++s)
+    if (std::isfinite(r.residuals[s].max))
+      fmt::print(" {} {:.1e} {:.1e};", stageName(Stage(s)), r.residuals[s].rms, r.residuals[s].max);
+  fmt::print("\n  NaN events: {}\n", r.nanEvents);
   for (const std::string& e : r.events) fmt::print("    {}\n", e);
   const auto mean = [&](Stage s) { return r.latency.stage(s, Phase::All).mean; };
   const double tv = mean(Stage::Volume), ts = mean(Stage::Strain), tm = mean(Stage::ShapeMatching);

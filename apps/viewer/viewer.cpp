@@ -120,6 +120,7 @@ class Viewer {
   void hapticsPanel();
   void forcePanel();
   void timingPanel();
+  void convergencePanel();
   void screenshot(int width, int height) const;
 
   GLFWwindow* window_;
@@ -135,7 +136,9 @@ class Viewer {
   bool stopped_ = false, failed_ = false;  // the running loop ended; it ended with an error
   double lastX_ = 0, lastY_ = 0;
   std::array<History, kFingerCount> force_, newtons_;
-  StageTimes stageMs_{};  // smoothed
+  StageTimes stageMs_{};                         // smoothed
+  std::array<Residual, kStageCount> residuals_;  // of the newest snapshot
+  int snapshotIterations_ = 0;
   double stepWallMs_ = 0.0, frameMs_ = 0.0;
   std::uint64_t lastStep_ = 0;
 };
@@ -183,6 +186,8 @@ void Viewer::takeSnapshot() {
   }
   const double a = 0.05;  // smoothing of the displayed times (about 20 snapshots)
   for (std::size_t i = 0; i < kStageCount; ++i) stageMs_.ms[i] += a * (s.times.ms[i] - stageMs_.ms[i]);
+  residuals_ = s.residuals;
+  snapshotIterations_ = s.iterations;
   stepWallMs_ += a * (s.stepWallMs - stepWallMs_);
 }
 
@@ -367,6 +372,24 @@ void Viewer::timingPanel() {
   }
 }
 
+void Viewer::convergencePanel() {
+  ImGui::Text("%d iterations this step; corrections of the last / mean rest edge:", snapshotIterations_);
+  if (ImGui::BeginTable("residuals", 3)) {
+    for (std::size_t i = 0; i < kStageCount; ++i) {
+      const Residual& r = residuals_[i];
+      if (!std::isfinite(r.max)) continue;
+      ImGui::TableNextRow();
+      ImGui::TableNextColumn();
+      ImGui::TextUnformatted(std::string(stageName(Stage(i))).c_str());
+      ImGui::TableNextColumn();
+      ImGui::Text("RMS %.1e", r.rms);
+      ImGui::TableNextColumn();
+      ImGui::Text("max %.1e", r.max);
+    }
+    ImGui::EndTable();
+  }
+}
+
 void Viewer::panels() {
   ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(430, 0), ImGuiCond_FirstUseEver);
@@ -377,6 +400,7 @@ void Viewer::panels() {
   if (ImGui::CollapsingHeader("Haptics")) hapticsPanel();
   if (ImGui::CollapsingHeader("Forces", ImGuiTreeNodeFlags_DefaultOpen)) forcePanel();
   if (ImGui::CollapsingHeader("Stage times")) timingPanel();
+  if (ImGui::CollapsingHeader("Convergence")) convergencePanel();
   ImGui::End();
 }
 

@@ -385,8 +385,8 @@ void validateAt(const Table& t, std::string_view prefix, F&& validate) {
 }
 
 SolverSettings readSolver(const Table& t) {
-  t.allowOnly(
-      {"rate", "dt", "substeps", "iterations", "gravity", "linear_damping", "simd", "threads", "fuse_strain_volume"});
+  t.allowOnly({"rate", "dt", "substeps", "iterations", "gravity", "linear_damping", "simd", "threads",
+               "fuse_strain_volume", "measure_residuals", "tolerance"});
   t.exclusive("rate", "dt");
   SolverSettings s;
   if (std::optional<Field> f = t.get("rate")) s.timeStep = 1.0f / float(f->integer(1, 100000));
@@ -400,6 +400,9 @@ SolverSettings readSolver(const Table& t) {
   s.simd = simd ? SimdLevel::Best : SimdLevel::Off;
   t.readInt("threads", s.threads, 1, 256);
   t.readBool("fuse_strain_volume", s.fuseStrainVolume);
+  s.measureResiduals = true;  // the scene default: runs and the viewer show how converged each step is
+  t.readBool("measure_residuals", s.measureResiduals);
+  t.readNumber("tolerance", s.tolerance, kNonNegative);
   validateAt(t, "solver", [&] { validateSolverSettings(s); });
   return s;
 }

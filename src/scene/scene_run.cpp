@@ -206,6 +206,9 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
 
   std::unique_ptr<RunFiles> files;
   Traces traces;
+  std::array<double, kStageCount> residualRmsSum{};
+  std::array<std::size_t, kStageCount> residualSteps{};
+  double iterations = 0.0;
   std::vector<PokeTrace> pokes;
   for (const HandAction& a : scene.actions)
     if (a.kind == ActionKind::Poke) pokes.push_back(PokeTrace{&a, {}, {}, {}});
@@ -226,6 +229,14 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
         world.step();
       }
       const StageTimes& times = session ? session->times() : world.lastStep().times;
+      iterations += world.lastStep().iterations;
+      for (std::size_t s = 0; s < kStageCount; ++s)
+        if (const Residual& r = world.lastStep().residuals[s]; std::isfinite(r.max)) {
+          residualRmsSum[s] += r.rms;
+          ++residualSteps[s];
+          summary.residuals[s].max =
+              std::max(std::isfinite(summary.residuals[s].max) ? summary.residuals[s].max : 0.0, r.max);
+        }
       summary.latency.add(times, contact);
       for (const SimEvent& e : world.takeEvents()) {
         ++summary.nanEvents;
@@ -263,6 +274,9 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
   for (HapticOutput* out : settings.outputs) out->release();
   for (const PokeTrace& p : pokes)
     if (p.complete(summary.dt)) summary.pokes.push_back(p.signal());
+  for (std::size_t s = 0; s < kStageCount; ++s)
+    if (residualSteps[s] > 0) summary.residuals[s].rms = residualRmsSum[s] / double(residualSteps[s]);
+  if (summary.steps > 0) summary.iterationsMean = iterations / double(summary.steps);
   summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (files && summary.ok) {
     try {
@@ -320,6 +334,13 @@ std::string summaryJson(const RunSummary& s) {
                      {"newtons", quality(p.newtons)},
                      {"force", quality(p.force)}});
   j["pokes"] = pokes;
+  json residuals = json::object();
+  for (std::size_t k = 0; k < kStageCount; ++k)
+    if (std::isfinite(s.residuals[k].max))
+      residuals[std::string(stageName(Stage(k)))] = {{"rms_mean", number(s.residuals[k].rms)},
+                                                     {"max", number(s.residuals[k].max)}};
+  j["residuals"] = residuals;
+  j["iterations_mean"] = number(s.iterationsMean);
   json stages = json::object();
   const auto stats = [&](const SampleStats& st) {
     return json{{"mean", number(st.mean)}, {"p50", number(st.median)}, {"p95", number(st.p95)},

@@ -34,6 +34,8 @@ void captureSnapshot(Snapshot& s, const World& world, const HapticSession* sessi
     s.contact = session->inContact();
   }
   s.times = session ? session->times() : world.lastStep().times;
+  s.residuals = world.lastStep().residuals;
+  s.iterations = world.lastStep().iterations;
   s.stepWallMs = stepWallMs;
 }
 

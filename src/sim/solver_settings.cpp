@@ -45,6 +45,8 @@ void validateSolverSettings(const SolverSettings& s) {
   if (!isFinite(s.gravity)) throw Error("solver: gravity must be finite");
   if (!(std::isfinite(s.linearDamping) && s.linearDamping >= 0.0f))
     throw Error(fmt::format("solver: linear damping must be finite and >= 0, got {}", s.linearDamping));
+  if (!(std::isfinite(s.tolerance) && s.tolerance >= 0.0f))
+    throw Error(fmt::format("solver: tolerance must be finite and >= 0, got {}", s.tolerance));
   if (s.threads < 1 || s.threads > 256)
     throw Error(fmt::format("solver: threads must be in [1, 256], got {}", s.threads));
   if (std::size_t(s.simd) > std::size_t(SimdLevel::Best)) throw Error("solver: unknown SIMD level");

@@ -33,6 +33,20 @@ void checkContactMode(FingertipContactMode mode, const char* what) {
     throw Error(fmt::format("{}: unknown fingertip contact mode {}", what, int(mode)));
 }
 
+// A body's length for its residuals: the mean rest edge of its tets, else of its distance
+// constraints, else 1 cm (a body of free particles).
+float meanRestEdge(const BodyModel& m) {
+  double sum = 0.0;
+  std::size_t count = 0;
+  const auto& x = m.restPositions;
+  for (const Tet& t : m.tets)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) sum += double((x[t[a]] - x[t[b]]).norm()), ++count;
+  if (count == 0)
+    for (const DistanceConstraint& c : m.distance) sum += double(c.restLength), ++count;
+  return count > 0 && sum > 0.0 ? float(sum / double(count)) : 0.01f;
+}
+
 // Zeroes a body's multipliers (Algorithm 1, line 9): a team member its share of each array.
 void clearMultipliers(Body& b, const SolverTeam& team = SolverTeam{}) {
   const auto clear = [&]<typename T>(T* values, std::size_t count, const T& zero) {
@@ -84,6 +98,7 @@ BodyId World::addBody(std::shared_ptr<const BodyModel> model, const Vec3& transl
   if (!model->strain.empty() && (tau.strainStretch > 0.0f || tau.strainShear > 0.0f || tau.volume > 0.0f))
     body.startDeformation.assign(9 * model->strain.size(), 0.0f);
   body.shapeMatchLambda.assign(model->shapeMatching ? model->particleCount() : 0, Vec3::Zero());
+  body.lengthScale = meanRestEdge(*model);
   body.shapeMatchRotation = rotation.cast<double>();
   for (std::size_t i = 0; i < model->particleCount(); ++i) {
     const Vec3 x = rotation * model->restPositions[i] + translation;
@@ -229,6 +244,7 @@ std::vector<SimEvent> World::takeEvents() { return std::exchange(events_, {}); }
 void World::step() {
   report_ = StepReport{};
   report_.step = stepCount_;
+  residualCount_.fill(0);
   // A team pays only for a body big enough to be cut in groups (body_model.cpp): a smaller array is
   // swept by one member anyway, and the others would only wait at its barriers.
   const bool cut = std::any_of(bodies_.begin(), bodies_.end(), [](const Body& b) {
@@ -244,6 +260,9 @@ void World::step() {
     memberFinite_.resize(bodies_.size());
     substeps(SolverTeam{});
   }
+  for (std::size_t s = 0; s < kStageCount; ++s)
+    if (residualCount_[s] > 0)
+      report_.residuals[s] = {std::sqrt(residualSumSq_[s] / double(residualCount_[s])), residualMax_[s]};
   const auto pushed = [](float l) { return l > 0.0f; };
   report_.colliderContacts =
       std::size_t(std::count_if(contactNormalLambda_.begin(), contactNormalLambda_.end(), pushed));
@@ -273,7 +292,26 @@ void World::substeps(const SolverTeam& team) {
     team.barrier();  // detection reads the fingertips' new centres
     detectContacts(team);
     startDeformations(plan, team);  // its closing barrier also closes detection
-    for (int it = 0; it < settings_.iterations; ++it) solveIteration(h, plan, team);
+    // Iterations: all of them, or (adaptive) until the largest correction is within the tolerance.
+    const bool adaptive = settings_.tolerance > 0.0f;
+    int it = 0;
+    while (it < settings_.iterations) {
+      const bool measure = adaptive || (settings_.measureResiduals && s + 1 == n && it + 1 == settings_.iterations);
+      if (measure && team.leader()) {
+        residualSumSq_.fill(0.0);
+        residualMax_.fill(0.0);
+        residualCount_.fill(0);
+      }
+      solveIteration(h, plan, team, measure);
+      ++it;
+      if (adaptive) {
+        if (team.leader())
+          converged_ = *std::max_element(residualMax_.begin(), residualMax_.end()) < settings_.tolerance;
+        team.barrier();  // (the leader writes it again only past the next iteration's barriers)
+        if (converged_) break;
+      }
+    }
+    if (team.leader()) report_.iterations += it;
     finalise(h, team);
   }
 }
@@ -509,7 +547,38 @@ void shapeMatching(Body& b, float tau, const sweeps::Range& r, std::span<ShapeMa
 
 }  // namespace
 
-void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team) {
+// One sweep of a constraint stage, and with `measure` its corrections: the moves of the particles
+// of `body` (every body's for the world constraints), relative to their body's length, added to
+// the stage's residual. The leader copies and compares, between barriers.
+template <typename Sweep>
+void World::measured(Stage stage, const Body* body, bool measure, const SolverTeam& team, Sweep&& sweep) {
+  if (!measure) return sweep();
+  const auto each = [&](auto&& f) {
+    for (const Body& b : bodies_)
+      if (b.state == BodyState::Active && (!body || &b == body))
+        for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) f(b, i);
+  };
+  if (team.leader()) {
+    residualStart_.resize(particles_.p.size());
+    each([&](const Body&, Index i) { residualStart_[i] = particles_.p[i].pos; });
+  }
+  team.barrier();
+  sweep();
+  team.barrier();
+  if (team.leader()) {
+    const std::size_t s = std::size_t(stage);
+    each([&](const Body& b, Index i) {
+      if (particles_.p[i].w == 0.0f) return;  // kinematic: never moved by a constraint
+      const double move = double((particles_.p[i].pos - residualStart_[i]).norm()) / double(b.lengthScale);
+      residualSumSq_[s] += move * move;
+      residualMax_[s] = std::max(residualMax_[s], move);
+      ++residualCount_[s];
+    });
+  }
+  team.barrier();
+}
+
+void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team, bool measure) {
   const float invH = 1.0f / h;
   const bool timed = settings_.timeStages && team.leader();
   StageTimes& times = report_.times;
@@ -522,57 +591,68 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
     const ConstraintDamping& tau = m.damping;
     const sweeps::Range r{pred + b.firstParticle, start + b.firstParticle, invH,
                           b.startDeformation.empty() ? nullptr : b.startDeformation.data()};
+    // One stage of this body's constraints: swept and timed, and measured when asked.
+    const auto stage = [&](Stage which, auto&& sweep) {
+      measured(which, &b, measure, team, [&] {
+        StageTimer t(times, which, timed);
+        sweep();
+      });
+    };
     if (!m.distance.empty()) {
-      StageTimer t(times, Stage::Distance, timed);
       const bool damped = tau.distance > 0.0f;
-      sweepColours(m.distanceColours, m.distanceGroups, m.distance.size(), plan, team,
-                   [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
-                     s.distance(m.distance.data(), begin, end, b.distanceLambda.data(), tau.distance, damped, r);
-                   });
+      stage(Stage::Distance, [&] {
+        sweepColours(m.distanceColours, m.distanceGroups, m.distance.size(), plan, team,
+                     [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
+                       s.distance(m.distance.data(), begin, end, b.distanceLambda.data(), tau.distance, damped, r);
+                     });
+      });
     }
     // Strain before volume: S = F^T F cannot tell a tet from its mirror image, so the signed
     // volume constraint gets the last word on orientation.
     if (settings_.fuseStrainVolume && b.tetsPaired) {
-      StageTimer t(times, Stage::StrainVolume, timed);
       const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f || tau.volume > 0.0f;
-      sweepColours(m.tetColours, m.tetGroups, m.strain.size(), plan, team,
-                   [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
-                     s.strainVolume(m.strain.data(), m.volume.data(), begin, end, b.strainLambda.data(),
-                                    b.volumeLambda.data(), m.strain.size(), tau, damped, r);
-                   });
-    } else {
-      if (!m.strain.empty()) {
-        StageTimer t(times, Stage::Strain, timed);
-        const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f;
+      stage(Stage::StrainVolume, [&] {
         sweepColours(m.tetColours, m.tetGroups, m.strain.size(), plan, team,
                      [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
-                       s.strain(m.strain.data(), begin, end, b.strainLambda.data(), m.strain.size(), tau, damped, r);
+                       s.strainVolume(m.strain.data(), m.volume.data(), begin, end, b.strainLambda.data(),
+                                      b.volumeLambda.data(), m.strain.size(), tau, damped, r);
                      });
+      });
+    } else {
+      if (!m.strain.empty()) {
+        const bool damped = tau.strainStretch > 0.0f || tau.strainShear > 0.0f;
+        stage(Stage::Strain, [&] {
+          sweepColours(m.tetColours, m.tetGroups, m.strain.size(), plan, team,
+                       [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
+                         s.strain(m.strain.data(), begin, end, b.strainLambda.data(), m.strain.size(), tau, damped, r);
+                       });
+        });
       }
       if (!m.volume.empty()) {
-        StageTimer t(times, Stage::Volume, timed);
         const bool damped = tau.volume > 0.0f;
-        sweepColours(m.tetColours, m.tetGroups, m.volume.size(), plan, team,
-                     [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
-                       s.volume(m.volume.data(), begin, end, b.volumeLambda.data(), tau.volume, damped, r);
-                     });
+        stage(Stage::Volume, [&] {
+          sweepColours(m.tetColours, m.tetGroups, m.volume.size(), plan, team,
+                       [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
+                         s.volume(m.volume.data(), begin, end, b.volumeLambda.data(), tau.volume, damped, r);
+                       });
+        });
       }
     }
     if (!m.bend.empty()) {
-      StageTimer t(times, Stage::Bend, timed);
       const bool damped = tau.bend > 0.0f;
       // In levels (levelOrder), without groups: on a team, one member sweeps them all.
-      sweepColours(m.bendLevels, {}, m.bend.size(), plan, team,
-                   [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
-                     s.bend(m.bend.data(), begin, end, b.bendLambda.data(), tau.bend, damped, r);
-                   });
+      stage(Stage::Bend, [&] {
+        sweepColours(m.bendLevels, {}, m.bend.size(), plan, team,
+                     [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
+                       s.bend(m.bend.data(), begin, end, b.bendLambda.data(), tau.bend, damped, r);
+                     });
+      });
     }
-    if (m.shapeMatching) {
-      StageTimer t(times, Stage::ShapeMatching, timed);
-      shapeMatching(b, tau.shapeMatching, r, shapeMatchSums_, *plan.widths[0], team);
-    }
+    if (m.shapeMatching)
+      stage(Stage::ShapeMatching,
+            [&] { shapeMatching(b, tau.shapeMatching, r, shapeMatchSums_, *plan.widths[0], team); });
   }
-  solveWorldConstraints(invH, timed, team);
+  measured(Stage::Contact, nullptr, measure, team, [&] { solveWorldConstraints(invH, timed, team); });
   team.barrier();
 }
 

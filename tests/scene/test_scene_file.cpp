@@ -47,6 +47,8 @@ linear_damping = 0.2
 simd = false
 threads = 2
 fuse_strain_volume = false
+measure_residuals = false
+tolerance = 1e-3
 
 [[body]]
 name = "liver"
@@ -206,6 +208,8 @@ TEST(SceneFile, FullSceneSetsEveryField) {
   EXPECT_EQ(s.solver.simd, SimdLevel::Off);
   EXPECT_EQ(s.solver.threads, 2);
   EXPECT_FALSE(s.solver.fuseStrainVolume);
+  EXPECT_FALSE(s.solver.measureResiduals);
+  EXPECT_FLOAT_EQ(s.solver.tolerance, 1e-3f);
 
   ASSERT_EQ(s.bodies.size(), 3u);
   const BodySpec& liver = s.bodies[0];
@@ -357,6 +361,8 @@ TEST(SceneFile, AbsentKeysKeepTheirDefaults) {
   EXPECT_EQ(s.solver.simd, SimdLevel::Best);
   EXPECT_EQ(s.solver.threads, 1);
   EXPECT_TRUE(s.solver.fuseStrainVolume);
+  EXPECT_TRUE(s.solver.measureResiduals);  // the scenes' default, unlike SolverSettings'
+  EXPECT_EQ(s.solver.tolerance, 0.0f);
 
   ASSERT_EQ(s.bodies.size(), 1u);
   const BodySpec& b = s.bodies[0];

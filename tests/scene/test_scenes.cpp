@@ -150,6 +150,8 @@ TEST(SceneRun, WritesEveryOutputAndASummaryWithTheDocumentedKeys) {
                           "volume_loss_final", "force_max", "stage_ms", "nan_events", "ok", "pokes"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_TRUE(j["pokes"].empty()) << "the poke was cut off at 2.5 s: no figures for half a press";
+  EXPECT_GT(j["residuals"]["strain_volume"]["max"].get<double>(), 0.0);  // measured, and not converged at 8 x 5
+  EXPECT_EQ(j["iterations_mean"].get<double>(), 40.0);
   EXPECT_EQ(j["scene"], "liver");
   EXPECT_EQ(j["steps"], 150);
   EXPECT_EQ(j["ok"], true);

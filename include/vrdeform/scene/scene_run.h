@@ -56,7 +56,11 @@ struct RunSummary {
   std::array<float, kFingerCount> forceMax{}, newtonsMax{};
   float paperMax = 0.0f;
   std::vector<PokeSignal> pokes;  ///< the scripted pokes that ran to their end
-  std::uint64_t nanEvents = 0;    ///< bodies frozen or particles reset after a NaN
+  /// How converged the steps were, per constraint stage (StepReport::residuals): the mean of the
+  /// steps' RMS and the largest max; NaN for stages not measured.
+  std::array<Residual, kStageCount> residuals;
+  double iterationsMean = 0.0;  ///< Gauss-Seidel iterations per step
+  std::uint64_t nanEvents = 0;  ///< bodies frozen or particles reset after a NaN
   std::vector<std::string> events;
   LatencyRecorder latency;  ///< per step: idle (no finger touching, no grasp) or contact
   double wallSeconds = 0.0;

@@ -34,6 +34,8 @@ struct Snapshot {
   bool grasping = false;                           ///< a grasp is holding the body
   bool contact = false;                            ///< a finger touches or a grasp holds (the latency phase)
   StageTimes times;                                ///< per-stage times of this step
+  std::array<Residual, kStageCount> residuals;     ///< how converged this step was (StepReport::residuals)
+  int iterations = 0;                              ///< Gauss-Seidel iterations this step ran
   double stepWallMs = 0.0;                         ///< wall time of input, simulation and outputs (ms)
 };
 

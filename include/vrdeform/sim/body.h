@@ -41,6 +41,7 @@ struct Body {
   Eigen::Quaterniond shapeMatchRotation = Eigen::Quaterniond::Identity();  ///< R of the last shape match (warm start)
 
   std::vector<Vec3> initialPositions;  ///< world positions at creation; resetBody() returns them at rest
+  float lengthScale = 0.01f;           ///< mean rest edge length (m): residuals are relative to it
 };
 
 }  // namespace vrd

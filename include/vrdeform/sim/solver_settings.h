@@ -50,6 +50,14 @@ struct SolverSettings {
   /// tet's particles once and costs about as much as the strain pass alone. Off: the paper's
   /// order, timed as Stage::Strain and Stage::Volume (its Table 1) instead of Stage::StrainVolume.
   bool fuseStrainVolume = true;
+  /// Measure how far each step's solve is from converged: every constraint type's corrections in
+  /// the last iteration (StepReport::residuals). Costs a copy of the bodies' positions per type,
+  /// once per step.
+  bool measureResiduals = false;
+  /// Adaptive budget: > 0 iterates each substep until no constraint type corrects any particle by
+  /// more than `tolerance` (relative to its body's mean rest edge) in an iteration, at most
+  /// `iterations` times; the step reports how many it ran. 0: always `iterations`.
+  float tolerance = 0.0f;
 
   float substepSize() const { return timeStep / float(substeps); }
 };

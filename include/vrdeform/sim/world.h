@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,10 +35,23 @@ struct SimEvent {
   std::string message;
 };
 
+/// How much one constraint type still corrected in a step's last iteration: each particle's move
+/// relative to its body's mean rest edge length, over the particles of the bodies that have the
+/// type. 0 at a fixed point of the solver; NaN when not measured.
+struct Residual {
+  double rms = std::numeric_limits<double>::quiet_NaN();
+  double max = std::numeric_limits<double>::quiet_NaN();
+};
+
 /// What the last call to step() did.
 struct StepReport {
-  std::uint64_t step = 0;             ///< index of the step (0-based)
-  StageTimes times;                   ///< summed over substeps and iterations
+  std::uint64_t step = 0;  ///< index of the step (0-based)
+  StageTimes times;        ///< summed over substeps and iterations
+  /// Per constraint stage (Distance, Volume, Strain, StrainVolume, Bend, ShapeMatching, and Contact
+  /// for every world constraint: attachments, collider and fingertip contacts), with
+  /// SolverSettings::measureResiduals or a tolerance.
+  std::array<Residual, kStageCount> residuals;
+  int iterations = 0;                 ///< Gauss-Seidel iterations run, summed over the substeps
   std::size_t colliderContacts = 0;   ///< contacts that pushed (lambda > 0) in the last substep
   std::size_t fingertipContacts = 0;  ///< fingertip contacts (particles and triangles) that pushed in the last substep
 };
@@ -157,7 +171,9 @@ class World {
   void detectTriangleContacts();
   void resetMultipliers(const SolverTeam& team);
   void startDeformations(const sweeps::LanePlan& plan, const SolverTeam& team);
-  void solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team);
+  void solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team, bool measure);
+  template <typename Sweep>
+  void measured(Stage stage, const Body* body, bool measure, const SolverTeam& team, Sweep&& sweep);
   void solveWorldConstraints(float invH, bool timed, const SolverTeam& team);
   void finalise(float h, const SolverTeam& team);
   void containNonFinite(BodyId id);
@@ -193,6 +209,12 @@ class World {
   std::array<ShapeMatchSums, 4> shapeMatchSums_;
   StepReport report_;
   std::uint64_t stepCount_ = 0;
+  // Residual measurement: positions before a type's sweep, and each stage's sum of squares,
+  // count and largest relative move in the iteration measured.
+  std::vector<Vec3> residualStart_;
+  std::array<double, kStageCount> residualSumSq_{}, residualMax_{};
+  std::array<std::size_t, kStageCount> residualCount_{};
+  bool converged_ = false;  // set by the leader in an adaptive iteration, read by all after a barrier
   // The solver's threads, made at the first step that uses them; a copy of the world makes its own.
   struct TeamSlot {
     std::unique_ptr<ThreadTeam> team;
