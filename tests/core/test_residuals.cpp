@@ -72,7 +72,9 @@ TEST(Residuals, AdaptiveBudgetMeetsItsTolerance) {
   EXPECT_GT(r.iterations, 2);
   EXPECT_LT(r.iterations, 500);
   for (const Residual& residual : r.residuals)
-    if (std::isfinite(residual.max)) EXPECT_LT(residual.max, tolerance);
+    if (std::isfinite(residual.max)) {
+      EXPECT_LT(residual.max, tolerance);
+    }
   // With a cap below what it needs, it stops at the cap.
   EXPECT_EQ(settled(2, 10, 1e-9f).iterations, 2);
   testing::record("adaptive_iterations", r.iterations);

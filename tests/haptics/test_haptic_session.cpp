@@ -15,35 +15,10 @@
 #include "vrdeform/io/surface_io.h"
 #include "vrdeform/io/tetrahedralise.h"
 #include "vrdeform/mesh/primitives.h"
+#include "vrdeform/metrics/signal_quality.h"
 
 namespace vrd {
 namespace {
-
-// Spearman's rank correlation (average ranks for ties).
-double spearman(const std::vector<double>& a, const std::vector<double>& b) {
-  auto ranks = [](const std::vector<double>& v) {
-    std::vector<std::size_t> order(v.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) { return v[i] < v[j]; });
-    std::vector<double> r(v.size());
-    for (std::size_t i = 0; i < order.size();) {
-      std::size_t j = i;
-      while (j + 1 < order.size() && v[order[j + 1]] == v[order[i]]) ++j;
-      for (std::size_t k = i; k <= j; ++k) r[order[k]] = 0.5 * double(i + j);
-      i = j + 1;
-    }
-    return r;
-  };
-  const std::vector<double> ra = ranks(a), rb = ranks(b);
-  const double n = double(a.size()), mean = (n - 1) / 2;
-  double cov = 0, va = 0, vb = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    cov += (ra[i] - mean) * (rb[i] - mean);
-    va += (ra[i] - mean) * (ra[i] - mean);
-    vb += (rb[i] - mean) * (rb[i] - mean);
-  }
-  return cov / std::sqrt(va * vb);
-}
 
 // The paper's liver (section 6): the coarse CGAL liver in metres, ~800 tets, resting on the
 // ground, settled under gravity.
