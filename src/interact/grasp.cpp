@@ -150,7 +150,7 @@ void Grasp::follow(World& world, const HandRig& rig) {
     Particles& particles = world.particles();
     for (Index i = 0; i < b.particleCount; ++i) {
       const Index g = b.firstParticle + i;
-      particles.x[g].pos = particles.p[g].pos = reference_[i] + shift;
+      particles.x[g].pos = reference_[i] + shift;
       particles.v[g] = velocity;
     }
     return;

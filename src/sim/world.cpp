@@ -60,6 +60,28 @@ void clearMultipliers(Body& b, const SolverTeam& team = SolverTeam{}) {
   clear(b.shapeMatchLambda.data(), b.shapeMatchLambda.size(), Vec3(Vec3::Zero()));
 }
 
+// A body-frame position in the world, and back, through the frame's origin in double.
+Vec3 worldOf(const Vec3d& origin, const Vec3& local) { return (origin + local.cast<double>()).cast<float>(); }
+Vec3 frameOf(const Vec3d& origin, const Vec3& world) { return (world.cast<double>() - origin).cast<float>(); }
+
+// Where a frame's origin should move (relative to it): to the centre of mass of the moving
+// particles (of all of them when none moves), snapped to twice the float spacing of the farthest
+// coordinate, so that the move is exact for the particles far from the centre.
+Vec3 centreOfMass(std::span<const Point> x) {
+  Vec3d sum = Vec3d::Zero(), all = Vec3d::Zero();
+  double mass = 0.0;
+  float extent = 0.0f;
+  for (const Point& p : x) {
+    extent = std::max(extent, p.pos.cwiseAbs().maxCoeff());
+    all += p.pos.cast<double>();
+    if (p.w > 0.0f) sum += p.pos.cast<double>() / double(p.w), mass += 1.0 / double(p.w);
+  }
+  if (x.empty() || !(extent > 0.0f) || !std::isfinite(extent)) return Vec3::Zero();
+  const Vec3d centre = mass > 0.0 ? Vec3d(sum / mass) : Vec3d(all / double(x.size()));
+  const double grid = std::ldexp(1.0, std::ilogb(extent) - 22);
+  return (centre / grid).array().round().matrix().cast<float>() * float(grid);
+}
+
 }  // namespace
 
 World::World(const SolverSettings& settings) { setSettings(settings); }
@@ -100,25 +122,40 @@ BodyId World::addBody(std::shared_ptr<const BodyModel> model, const Vec3& transl
   body.shapeMatchLambda.assign(model->shapeMatching ? model->particleCount() : 0, Vec3::Zero());
   body.lengthScale = meanRestEdge(*model);
   body.shapeMatchRotation = rotation.cast<double>();
-  for (std::size_t i = 0; i < model->particleCount(); ++i) {
-    const Vec3 x = rotation * model->restPositions[i] + translation;
-    body.initialPositions.push_back(x);
-    particles_.x.push_back({x, model->invMass[i]});
-    particles_.p.push_back({x, model->invMass[i]});
+  // The frame: the rotated rest shape about its centre of mass, which the translation places.
+  std::vector<Point> placed;
+  for (std::size_t i = 0; i < model->particleCount(); ++i)
+    placed.push_back({rotation * model->restPositions[i], model->invMass[i]});
+  const Vec3 centre = centreOfMass(placed);
+  body.origin = body.initialOrigin = translation.cast<double>() + centre.cast<double>();
+  const BodyId id = BodyId(bodies_.size());
+  for (Point& p : placed) {
+    p.pos -= centre;
+    body.initialPositions.push_back(p.pos);
+    local_.push_back(p);
+    predicted_.push_back(p);
+    particles_.x.push_back({worldOf(body.origin, p.pos), p.w});
     particles_.v.push_back(Vec3::Zero());
     particles_.force.push_back(Vec3::Zero());
+    particleBody_.push_back(id);
   }
   bodies_.push_back(std::move(body));
-  return BodyId(bodies_.size() - 1);
+  frameColliders();
+  frameFingertips();
+  return id;
 }
 
 void World::resetBody(BodyId id) {
   Body& b = bodies_.at(id);
+  b.origin = b.initialOrigin;
   for (Index i = 0; i < b.particleCount; ++i) {
     const Index g = b.firstParticle + i;
-    particles_.x[g].pos = particles_.p[g].pos = b.initialPositions[i];
+    local_[g].pos = predicted_[g].pos = b.initialPositions[i];
+    particles_.x[g].pos = worldOf(b.origin, b.initialPositions[i]);
     particles_.v[g].setZero();
   }
+  frameColliders();
+  frameFingertips();
   clearMultipliers(b);
   b.shapeMatchRotation = Eigen::Quaterniond::Identity();
   b.state = BodyState::Active;
@@ -128,7 +165,7 @@ void World::setInverseMass(Index particle, float w) {
   if (particle >= particles_.size()) throw Error(fmt::format("setInverseMass: no particle {}", particle));
   if (!(std::isfinite(w) && w >= 0.0f))
     throw Error(fmt::format("setInverseMass: inverse mass must be >= 0, got {}", w));
-  particles_.x[particle].w = particles_.p[particle].w = w;
+  particles_.x[particle].w = local_[particle].w = predicted_[particle].w = w;
 }
 
 void World::setExternalForce(BodyId id, const Vec3& force, const Vec3& perKg) {
@@ -177,6 +214,7 @@ Vec3 World::attachmentForce(AttachmentId id) const {
 ColliderId World::addCollider(const Collider& collider) {
   validateCollider(collider);
   colliders_.push_back(collider);
+  frameColliders();
   return ColliderId(colliders_.size() - 1);
 }
 
@@ -187,6 +225,7 @@ FingertipId World::addFingertip(const Vec3& center, float radius, float complian
   checkCompliance(compliance, "addFingertip");
   checkContactMode(mode, "addFingertip");
   fingertips_.push_back({center, center, radius, compliance, true, mode, {}, center});
+  frameFingertips();
   return FingertipId(fingertips_.size() - 1);
 }
 
@@ -215,10 +254,11 @@ Vec3 World::fingertipForce(FingertipId id) const {
   Vec3 force = Vec3::Zero();
   const Fingertip& f = fingertips_.at(id);
   for (std::size_t c = 0; c < fingertipContacts_.size(); ++c)
-    if (fingertipContacts_[c].fingertip == id)
-      force += fingertipLambda_[c] *
-                   evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, f.center, f.radius).n +
+    if (const FingertipContact& con = fingertipContacts_[c]; con.fingertip == id) {
+      const Vec3 centre = frameFingertip(particleBody_[con.particle], id).center;
+      force += fingertipLambda_[c] * evalSphereContact(local_[con.particle].pos, centre, f.radius).n +
                fingertipFrictionLambda_[c];
+    }
   for (std::size_t c = 0; c < fingertipTriangleContacts_.size(); ++c)
     if (fingertipTriangleContacts_[c].fingertip == id)
       for (const Vec3& impulse : fingertipTriangleImpulse_[c]) force += impulse;
@@ -249,6 +289,7 @@ void World::step() {
   report_ = StepReport{};
   report_.step = stepCount_;
   residualCount_.fill(0);
+  ingest();
   // A team pays only for a body big enough to be cut in groups (body_model.cpp): a smaller array is
   // swept by one member anyway, and the others would only wait at its barriers.
   const bool cut = std::any_of(bodies_.begin(), bodies_.end(), [](const Body& b) {
@@ -273,7 +314,78 @@ void World::step() {
   report_.fingertipContacts =
       std::size_t(std::count_if(fingertipLambda_.begin(), fingertipLambda_.end(), pushed) +
                   std::count_if(fingertipTriangleLambda_.begin(), fingertipTriangleLambda_.end(), pushed));
+  publish();
   ++stepCount_;
+}
+
+// A world position that differs from the one published is the caller's: it moves the particle.
+void World::ingest() {
+  for (BodyId id = 0; id < bodies_.size(); ++id) {
+    const Body& b = bodies_[id];
+    for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
+      const Point& x = particles_.x[i];
+      if (x.pos != worldOf(b.origin, local_[i].pos)) local_[i].pos = frameOf(b.origin, x.pos);
+      local_[i].w = predicted_[i].w = x.w;
+    }
+  }
+}
+
+void World::frameColliders() {
+  frameColliders_.clear();
+  for (const Body& b : bodies_)
+    for (Collider c : colliders_) {
+      c.center = frameOf(b.origin, c.center);
+      frameColliders_.push_back(c);
+    }
+}
+
+// Between steps the fingertips are where they are; in a step's substep, at `from` and `to` of the
+// way from the step's start to their goals (double, from fingertipFrom_).
+void World::frameFingertips(double from, double to) {
+  const bool moving = fingertipFrom_.size() == fingertips_.size();
+  const auto along = [&](std::size_t f, double t) {
+    const Vec3d start = fingertipFrom_[f];
+    return Vec3d(start + t * (fingertips_[f].goal.cast<double>() - start));
+  };
+  if (moving)
+    for (std::size_t f = 0; f < fingertips_.size(); ++f) {
+      fingertips_[f].substepStart = along(f, from).cast<float>();
+      fingertips_[f].center = along(f, to).cast<float>();
+    }
+  frameFingertips_.clear();
+  for (const Body& b : bodies_)
+    for (std::size_t f = 0; f < fingertips_.size(); ++f) {
+      Fingertip tip = fingertips_[f];
+      if (moving) {
+        tip.center = (along(f, to) - b.origin).cast<float>();
+        tip.substepStart = (along(f, from) - b.origin).cast<float>();
+      } else {
+        tip.center = frameOf(b.origin, tip.center);
+        tip.substepStart = frameOf(b.origin, tip.substepStart);
+      }
+      frameFingertips_.push_back(tip);
+    }
+}
+
+// Each active body's frame moves to the centre of mass of its moving particles: they move by the
+// same (snapped) amount and keep their velocities; a kinematic particle keeps its world position,
+// so that one held still does not wander by a rounding each step. Then the world view.
+void World::publish() {
+  for (Body& b : bodies_) {
+    Point* const x = local_.data() + b.firstParticle;
+    const Vec3 shift = b.state == BodyState::Active ? centreOfMass({x, b.particleCount}) : Vec3::Zero();
+    if (shift != Vec3::Zero()) {
+      const Vec3d from = b.origin;
+      b.origin += shift.cast<double>();
+      for (Index i = 0; i < b.particleCount; ++i)
+        x[i].pos = x[i].w > 0.0f ? Vec3(x[i].pos - shift) : frameOf(b.origin, worldOf(from, x[i].pos));
+    }
+    for (Index i = 0; i < b.particleCount; ++i)
+      particles_.x[b.firstParticle + i] = {worldOf(b.origin, x[i].pos), x[i].w};
+  }
+  frameColliders();  // the contacts' readouts (fingertipForce, ...) compare with the frames' positions
+  fingertipFrom_.clear();
+  frameFingertips();
 }
 
 // Algorithm 1 by a team: each member predicts, detects and finalises its share of the particles,
@@ -284,13 +396,16 @@ void World::substeps(const SolverTeam& team) {
   const sweeps::LanePlan plan = sweeps::lanePlan(settings_.simd);
   for (int s = 0; s < n; ++s) {
     if (team.leader()) {
-      // Kinematic targets move linearly from where they were to their goals over the step.
+      // Kinematic targets move linearly from where they were to their goals over the step; the
+      // fingertips' centres in double from the step's start, so that their frame positions do not
+      // depend on where in the world they are.
       const float share = 1.0f / float(n - s);
       for (Attachment& a : attachments_) a.target += share * (a.goal - a.target);
-      for (Fingertip& f : fingertips_) {
-        f.substepStart = f.center;
-        f.center += share * (f.goal - f.center);
+      if (s == 0) {
+        fingertipFrom_.clear();
+        for (const Fingertip& f : fingertips_) fingertipFrom_.push_back(f.center.cast<double>());
       }
+      frameFingertips(double(s) / n, double(s + 1) / n);
     }
     predict(h, team);
     team.barrier();  // detection reads the fingertips' new centres
@@ -323,7 +438,7 @@ void World::substeps(const SolverTeam& team) {
 // This member's share of a body's particles: the team cuts all particles at multiples of 64 (cache
 // line boundaries of the Points, 16 bytes, and of the velocities, 12 bytes), then clips to the body.
 std::pair<Index, Index> World::particlesOf(const Body& b, const SolverTeam& team) const {
-  const auto [first, last] = team.share(0, particles_.p.size(), 64);
+  const auto [first, last] = team.share(0, predicted_.size(), 64);
   return {std::max(Index(first), b.firstParticle), std::min(Index(last), b.firstParticle + b.particleCount)};
 }
 
@@ -333,10 +448,10 @@ void World::predict(float h, const SolverTeam& team) {
   for (const Body& b : bodies_) {
     if (b.state != BodyState::Active) continue;
     for (auto [i, end] = particlesOf(b, team); i < end; ++i) {
-      const Point& x = particles_.x[i];
+      const Point& x = local_[i];
       Vec3& v = particles_.v[i];
       if (x.w > 0.0f) v = keep * v + h * (settings_.gravity + x.w * particles_.force[i]);  // damp, then add forces
-      particles_.p[i] = {x.pos + h * v, x.w};  // kinematic particles follow their velocity
+      predicted_[i] = {x.pos + h * v, x.w};  // kinematic particles follow their velocity
     }
   }
 }
@@ -371,27 +486,30 @@ void World::detectParticleContacts(const SolverTeam& team, std::vector<ColliderC
   const bool tips = std::any_of(fingertips_.begin(), fingertips_.end(), [](const Fingertip& f) {
     return f.enabled && f.mode == FingertipContactMode::Particles;
   });
-  for (const Body& b : bodies_) {
+  for (BodyId id = 0; id < bodies_.size(); ++id) {
+    const Body& b = bodies_[id];
     if (b.state != BodyState::Active) continue;
     const float radius = b.model->particleRadius;
     for (auto [i, end] = particlesOf(b, team); i < end; ++i) {
-      const Point& p = particles_.p[i];
+      const Point& p = predicted_[i];
       if (p.w == 0.0f) continue;
       // Anything the particle could reach in this substep: its predicted motion as margin. The
       // contacts are inequalities, so candidates that stay clear cost a check and do nothing.
       // distance < radius + motion, squared where both sides are positive (no square root).
-      const float motion2 = (p.pos - particles_.x[i].pos).squaredNorm();
+      const float motion2 = (p.pos - local_[i].pos).squaredNorm();
       for (Index c = 0; c < colliders_.size(); ++c)
-        if (const float gap = closestSurface(colliders_[c], p.pos).distance - radius; gap < 0.0f || gap * gap < motion2)
+        if (const float gap = closestSurface(frameCollider(id, c), p.pos).distance - radius;
+            gap < 0.0f || gap * gap < motion2)
           colliderContacts.push_back({i, c, radius});
       if (!tips) continue;
       // Eq. 36: N(r) from the predicted positions, widened by the same margin plus a skin, so that
       // a particle resting on the fingertip is not dropped when its prediction lands just outside.
       const float motion = std::sqrt(motion2);
       for (Index f = 0; f < fingertips_.size(); ++f) {
-        if (!fingertips_[f].enabled || fingertips_[f].mode != FingertipContactMode::Particles) continue;
-        const float reach = fingertips_[f].radius * (1.0f + kFingertipSkin) + motion;
-        if ((p.pos - fingertips_[f].center).squaredNorm() <= reach * reach) fingertipContacts.push_back({i, f});
+        const Fingertip& tip = frameFingertip(id, f);
+        if (!tip.enabled || tip.mode != FingertipContactMode::Particles) continue;
+        const float reach = tip.radius * (1.0f + kFingertipSkin) + motion;
+        if ((p.pos - tip.center).squaredNorm() <= reach * reach) fingertipContacts.push_back({i, f});
       }
     }
   }
@@ -405,9 +523,10 @@ void World::detectTriangleContacts() {
   if (std::none_of(fingertips_.begin(), fingertips_.end(),
                    [](const Fingertip& f) { return f.enabled && f.mode == FingertipContactMode::Triangles; }))
     return;
-  const Point* const pred = particles_.p.data();
-  const Point* const start = particles_.x.data();
-  for (const Body& b : bodies_) {
+  const Point* const pred = predicted_.data();
+  const Point* const start = local_.data();
+  for (BodyId id = 0; id < bodies_.size(); ++id) {
+    const Body& b = bodies_[id];
     if (b.state != BodyState::Active) continue;
     for (const Triangle& t : b.model->surface) {
       const Index i[3] = {b.firstParticle + t[0], b.firstParticle + t[1], b.firstParticle + t[2]};
@@ -419,7 +538,7 @@ void World::detectTriangleContacts() {
                               (p2.pos - start[i[2]].pos).squaredNorm()}));
       const Vec3 lo = p0.pos.cwiseMin(p1.pos).cwiseMin(p2.pos), hi = p0.pos.cwiseMax(p1.pos).cwiseMax(p2.pos);
       for (Index f = 0; f < fingertips_.size(); ++f) {
-        const Fingertip& tip = fingertips_[f];
+        const Fingertip& tip = frameFingertip(id, f);
         if (!tip.enabled || tip.mode != FingertipContactMode::Triangles) continue;
         const float reach = tip.radius * (1.0f + kFingertipSkin) + motion;
         if (((tip.center.array() + reach) < lo.array()).any() || ((tip.center.array() - reach) > hi.array()).any())
@@ -451,7 +570,7 @@ void World::startDeformations(const sweeps::LanePlan& plan, const SolverTeam& te
   for (Body& b : bodies_) {
     if (b.state != BodyState::Active || b.startDeformation.empty()) continue;
     const BodyModel& m = *b.model;
-    const sweeps::Range r{nullptr, particles_.x.data() + b.firstParticle, 0.0f, nullptr};
+    const sweeps::Range r{nullptr, local_.data() + b.firstParticle, 0.0f, nullptr};
     const auto [begin, end] = team.share(0, m.strain.size(), 16);
     plan.run(begin, end, [&](const sweeps::LaneSweeps& s, std::size_t first, std::size_t last) {
       s.startDeformation(m.strain.data(), first, last, b.startDeformation.data(), m.strain.size(), r);
@@ -563,8 +682,8 @@ void World::measured(Stage stage, const Body* body, bool measure, const SolverTe
         for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) f(b, i);
   };
   if (team.leader()) {
-    residualStart_.resize(particles_.p.size());
-    each([&](const Body&, Index i) { residualStart_[i] = particles_.p[i].pos; });
+    residualStart_.resize(predicted_.size());
+    each([&](const Body&, Index i) { residualStart_[i] = predicted_[i].pos; });
   }
   team.barrier();
   sweep();
@@ -572,8 +691,8 @@ void World::measured(Stage stage, const Body* body, bool measure, const SolverTe
   if (team.leader()) {
     const std::size_t s = std::size_t(stage);
     each([&](const Body& b, Index i) {
-      if (particles_.p[i].w == 0.0f) return;  // kinematic: never moved by a constraint
-      const double move = double((particles_.p[i].pos - residualStart_[i]).norm()) / double(b.lengthScale);
+      if (predicted_[i].w == 0.0f) return;  // kinematic: never moved by a constraint
+      const double move = double((predicted_[i].pos - residualStart_[i]).norm()) / double(b.lengthScale);
       residualSumSq_[s] += move * move;
       residualMax_[s] = std::max(residualMax_[s], move);
       ++residualCount_[s];
@@ -586,8 +705,8 @@ void World::solveIteration(float h, const sweeps::LanePlan& plan, const SolverTe
   const float invH = 1.0f / h;
   const bool timed = settings_.timeStages && team.leader();
   StageTimes& times = report_.times;
-  Point* const pred = particles_.p.data();
-  const Point* const start = particles_.x.data();
+  Point* const pred = predicted_.data();
+  const Point* const start = local_.data();
 
   for (Body& b : bodies_) {
     if (b.state != BodyState::Active) continue;
@@ -678,8 +797,8 @@ std::pair<std::size_t, std::size_t> contactsOf(const std::vector<Contact>& conta
 // member in their order, so the result is the one-thread result.
 void World::solveWorldConstraints(float invH, bool timed, const SolverTeam& team) {
   StageTimes& times = report_.times;
-  Point* const pred = particles_.p.data();
-  const Point* const start = particles_.x.data();
+  Point* const pred = predicted_.data();
+  const Point* const start = local_.data();
   if (!attachments_.empty()) {
     if (team.leader()) {
       StageTimer t(times, Stage::Attachment, timed);
@@ -687,7 +806,8 @@ void World::solveWorldConstraints(float invH, bool timed, const SolverTeam& team
         const Attachment& at = attachments_[a];
         if (at.particle == kNoParticle) continue;
         Point& q = pred[at.particle];
-        const Vec3 dLambda = solveAttachment(q, at.target, at.axes, attachmentLambda_[a],
+        const Vec3 target = frameOf(bodies_[particleBody_[at.particle]].origin, at.target);
+        const Vec3 dLambda = solveAttachment(q, target, at.axes, attachmentLambda_[a],
                                              XpbdCoefficients::make(at.compliance, at.dampingTime, invH),
                                              q.pos - start[at.particle].pos);
         attachmentLambda_[a] += dLambda;
@@ -709,7 +829,7 @@ void World::solveWorldConstraints(float invH, bool timed, const SolverTeam& team
     const auto [begin, end] = contactsOf(colliderContacts_, firstParticle, lastParticle);
     for (std::size_t c = begin; c < end; ++c) {
       const ColliderContact& con = colliderContacts_[c];
-      const Collider& collider = colliders_[con.collider];
+      const Collider& collider = frameCollider(particleBody_[con.particle], con.collider);
       Point& q = pred[con.particle];
       const ContactCorrection r = solveColliderContact(
           q, start[con.particle].pos, closestSurface(collider, q.pos), con.particleRadius, collider,
@@ -724,7 +844,7 @@ void World::solveWorldConstraints(float invH, bool timed, const SolverTeam& team
     const auto [begin, end] = contactsOf(fingertipContacts_, firstParticle, lastParticle);
     for (std::size_t c = begin; c < end; ++c) {
       const FingertipContact& con = fingertipContacts_[c];
-      const Fingertip& f = fingertips_[con.fingertip];
+      const Fingertip& f = frameFingertip(particleBody_[con.particle], con.fingertip);
       Point& q = pred[con.particle];
       const Correction<Vec3, 1> r = solveFingertipContact(q, f.center, f.radius, fingertipLambda_[c],
                                                           XpbdCoefficients::make(f.compliance, 0.0f, invH));
@@ -742,7 +862,7 @@ void World::solveWorldConstraints(float invH, bool timed, const SolverTeam& team
     StageTimer t(times, Stage::Fingertip, timed);
     for (std::size_t c = 0; c < fingertipTriangleContacts_.size(); ++c) {
       const FingertipTriangleContact& con = fingertipTriangleContacts_[c];
-      const Fingertip& f = fingertips_[con.fingertip];
+      const Fingertip& f = frameFingertip(particleBody_[con.i[0]], con.fingertip);
       Point &q0 = pred[con.i[0]], &q1 = pred[con.i[1]], &q2 = pred[con.i[2]];
       const TriangleContactCorrection r =
           solveFingertipTriangleContact(q0, q1, q2, f.center, f.radius, fingertipTriangleLambda_[c],
@@ -778,7 +898,7 @@ void World::finalise(float h, const SolverTeam& team) {
     std::uint8_t flag = kInactive;
     if (b.state == BodyState::Active) {
       bool finite = true;
-      for (auto [i, end] = particlesOf(b, team); i < end; ++i) finite &= isFinite(particles_.p[i].pos);
+      for (auto [i, end] = particlesOf(b, team); i < end; ++i) finite &= isFinite(predicted_[i].pos);
       flag = finite ? kFinite : kNonFinite;
     }
     memberFinite_[std::size_t(team.index) * bodies + id] = flag;
@@ -796,8 +916,8 @@ void World::finalise(float h, const SolverTeam& team) {
       continue;
     }
     for (auto [i, end] = particlesOf(bodies_[id], team); i < end; ++i) {  // Algorithm 1, lines 19-20
-      particles_.v[i] = (particles_.p[i].pos - particles_.x[i].pos) * invH;
-      particles_.x[i].pos = particles_.p[i].pos;
+      particles_.v[i] = (predicted_[i].pos - local_[i].pos) * invH;
+      local_[i].pos = predicted_[i].pos;
     }
   }
   if (contained) team.barrier();
@@ -806,15 +926,15 @@ void World::finalise(float h, const SolverTeam& team) {
 void World::containNonFinite(BodyId id) {
   Body& b = bodies_[id];
   Index first = b.firstParticle;
-  while (isFinite(particles_.p[first].pos)) ++first;
+  while (isFinite(predicted_[first].pos)) ++first;
   bool lastStateFinite = true;  // the committed positions; velocities are zeroed anyway
   for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i)
-    lastStateFinite &= isFinite(particles_.x[i].pos);
+    lastStateFinite &= isFinite(local_[i].pos);
   const std::string what =
       fmt::format("body {}: non-finite position of particle {} in step {}", id, first - b.firstParticle, stepCount_);
   if (settings_.onNan == NanPolicy::Freeze && lastStateFinite) {
     for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
-      particles_.p[i].pos = particles_.x[i].pos;
+      predicted_[i].pos = local_[i].pos;
       particles_.v[i].setZero();
     }
     b.state = BodyState::Frozen;
@@ -825,20 +945,30 @@ void World::containNonFinite(BodyId id) {
   }
 }
 
+// With a world position written since the last step, where ingest will put it.
+Vec3 World::framePosition(Index i) const {
+  const Vec3d& origin = bodies_[particleBody_[i]].origin;
+  const Vec3& x = particles_.x[i].pos;
+  return x != worldOf(origin, local_[i].pos) ? frameOf(origin, x) : local_[i].pos;
+}
+
+Vec3d World::position(Index particle) const {
+  if (particle >= particles_.size()) throw Error(fmt::format("position: no particle {}", particle));
+  return bodies_[particleBody_[particle]].origin + framePosition(particle).cast<double>();
+}
+
 double World::volume(BodyId id) const {
   const Body& b = bodies_.at(id);
-  const Point* x = particles_.x.data() + b.firstParticle;
+  const auto at = [&](Index v) -> Vec3d { return framePosition(b.firstParticle + v).cast<double>(); };
   double sum = 0.0;
-  for (const Tet& t : b.model->tets)
-    sum += signedTetVolume<double>(x[t[0]].pos.cast<double>(), x[t[1]].pos.cast<double>(), x[t[2]].pos.cast<double>(),
-                                   x[t[3]].pos.cast<double>());
+  for (const Tet& t : b.model->tets) sum += signedTetVolume<double>(at(t[0]), at(t[1]), at(t[2]), at(t[3]));
   return sum;
 }
 
 std::size_t World::bodyBytes(BodyId id) const {
   const Body& b = bodies_.at(id);
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  const std::size_t perParticle = 2 * sizeof(Point) + 2 * sizeof(Vec3);  // x, p, v, force
+  const std::size_t perParticle = 3 * sizeof(Point) + 2 * sizeof(Vec3) + sizeof(BodyId);  // x, frame x and p, v, force
   return b.model->bytes() + bytes(b.distanceLambda) + bytes(b.volumeLambda) + b.strainLambda.bytes() +
          bytes(b.bendLambda) + bytes(b.startDeformation) + bytes(b.shapeMatchLambda) + bytes(b.initialPositions) +
          b.particleCount * perParticle;
@@ -853,7 +983,7 @@ std::vector<Vec3> World::particleMaterialForces(BodyId id) const {
   const Body& b = bodies_.at(id);
   const BodyModel& m = *b.model;
   const float h = substepSize(), invH2 = 1.0f / (h * h);
-  const Point* x = particles_.x.data() + b.firstParticle;
+  const Point* x = local_.data() + b.firstParticle;
   std::vector<Vec3> f(b.particleCount, Vec3::Zero());
   auto add = [&](const auto& idx, const auto& grad, float lambda) {
     for (std::size_t k = 0; k < std::size(idx); ++k) f[idx[k]] += lambda * invH2 * grad[k];
@@ -899,15 +1029,15 @@ std::vector<Vec3> World::particleConstraintForces(BodyId id) const {
   for (std::size_t c = 0; c < colliderContacts_.size(); ++c)
     if (Vec3* fi = local(colliderContacts_[c].particle)) {
       const Vec3 n =
-          closestSurface(colliders_[colliderContacts_[c].collider], particles_.x[colliderContacts_[c].particle].pos)
+          closestSurface(frameCollider(id, colliderContacts_[c].collider), local_[colliderContacts_[c].particle].pos)
               .normal;
       *fi += (contactNormalLambda_[c] * n + contactFrictionLambda_[c]) * invH2;
     }
   for (std::size_t c = 0; c < fingertipContacts_.size(); ++c)
     if (Vec3* fi = local(fingertipContacts_[c].particle)) {
-      const Fingertip& tip = fingertips_[fingertipContacts_[c].fingertip];
+      const Fingertip& tip = frameFingertip(id, fingertipContacts_[c].fingertip);
       *fi += (fingertipLambda_[c] *
-                  evalSphereContact(particles_.x[fingertipContacts_[c].particle].pos, tip.center, tip.radius).n +
+                  evalSphereContact(local_[fingertipContacts_[c].particle].pos, tip.center, tip.radius).n +
               fingertipFrictionLambda_[c]) *
              invH2;
     }

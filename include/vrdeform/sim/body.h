@@ -40,7 +40,12 @@ struct Body {
   bool tetsPaired = false;
   Eigen::Quaterniond shapeMatchRotation = Eigen::Quaterniond::Identity();  ///< R of the last shape match (warm start)
 
-  std::vector<Vec3> initialPositions;  ///< world positions at creation; resetBody() returns them at rest
+  /// Where the body's frame is: the solver keeps its particles' positions relative to this point,
+  /// which follows the centre of mass of its moving particles, so that their float resolution is
+  /// that of the body's size wherever the body is (docs/precision.md).
+  Vec3d origin = Vec3d::Zero();
+  Vec3d initialOrigin = Vec3d::Zero();
+  std::vector<Vec3> initialPositions;  ///< in the frame at initialOrigin; resetBody() returns them at rest
   float lengthScale = 0.01f;           ///< mean rest edge length (m): residuals are relative to it
 };
 

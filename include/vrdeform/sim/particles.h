@@ -14,9 +14,11 @@ struct alignas(16) Point {
   float w;  ///< inverse mass (1/kg); 0 = kinematic (moved only by its velocity)
 };
 
+/// The world's view of its particles. The solver keeps each body's positions in the body's own
+/// frame (Body::origin) and writes the world positions here after every step; a position written
+/// here between steps moves the particle there.
 struct Particles {
-  std::vector<Point> x;     ///< positions at the start of the (sub)step; x[i].w is the inverse mass
-  std::vector<Point> p;     ///< predicted positions that the constraints correct; p[i].w mirrors x[i].w
+  std::vector<Point> x;     ///< world positions; x[i].w is the inverse mass
   std::vector<Vec3> v;      ///< velocities (m/s)
   std::vector<Vec3> force;  ///< constant external force on each particle (N), e.g. wind
 

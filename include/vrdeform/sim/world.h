@@ -79,6 +79,9 @@ class World {
   Particles& particles() { return particles_; }
   const Particles& particles() const { return particles_; }
   Index particleIndex(BodyId body, Index local) const { return bodies_.at(body).firstParticle + local; }
+  /// A particle's world position in double: its body's origin plus its position in the body's
+  /// frame, which particles().x rounds to the float spacing of the world coordinate.
+  Vec3d position(Index particle) const;
   /// Sets a particle's inverse mass; 0 makes it kinematic.
   void setInverseMass(Index particle, float w);
   /// Applies a constant force to every particle of a body: `force` (N) to each, plus `perKg`
@@ -179,9 +182,27 @@ class World {
   void solveWorldConstraints(float invH, bool timed, const SolverTeam& team);
   void finalise(float h, const SolverTeam& team);
   void containNonFinite(BodyId id);
+  // Body frames: the world positions the caller moved, into their bodies' frames; the colliders
+  // and fingertips into every body's frame (kept in step with the lists and the origins); each
+  // frame re-centred and the world positions written.
+  void ingest();
+  void frameColliders();
+  void frameFingertips(double from = 1.0, double to = 1.0);
+  void publish();
+  Vec3 framePosition(Index particle) const;
+  const Collider& frameCollider(BodyId body, Index c) const { return frameColliders_[body * colliders_.size() + c]; }
+  const Fingertip& frameFingertip(BodyId body, Index f) const {
+    return frameFingertips_[body * fingertips_.size() + f];
+  }
 
   SolverSettings settings_;
-  Particles particles_;
+  Particles particles_;                     // the world view, written after each step
+  std::vector<Point> local_;                // x: positions in their body's frame at the substep's start
+  std::vector<Point> predicted_;            // p: the predictions the constraints correct, in the same frames
+  std::vector<BodyId> particleBody_;        // each particle's body
+  std::vector<Collider> frameColliders_;    // colliders in each body's frame: [body * colliders + c]
+  std::vector<Fingertip> frameFingertips_;  // fingertips in each body's frame: [body * fingertips + f]
+  std::vector<Vec3d> fingertipFrom_;        // the fingertips' centres at the start of the step
   std::vector<Body> bodies_;
   std::vector<Attachment> attachments_;  // detached ones have particle == kNoParticle
   std::vector<Vec3> attachmentLambda_;
