@@ -936,7 +936,7 @@ std::string devicesFrame(const DevicesStatus& devices, std::uint64_t timestampMs
       nodes.push_back(std::move(node));
     }
     if (devices.pro) {  // §7.8, in the order of its example
-      item["signalStrength"] = dev.signalStrength;
+      item["signalStrength"] = std::isfinite(dev.signalStrength) ? dev.signalStrength : 0.0;  // JSON has no NaN
       item["sensorsCalibDate"] = dev.sensorsCalibDate;
       OrderedJson master;
       master["batteryLevel"] = dev.batteryLevel;

@@ -102,7 +102,7 @@ struct DevicesStatus {
     bool charging = false;
     std::vector<Node> nodes;
     // WEART_TD_PRO_STATUS only (§7.8); devicesFrame writes them for a Pro, the parser reads them when sent.
-    double signalStrength = 0.0;   ///< RSSI in dBm
+    double signalStrength = 0.0;   ///< RSSI in dBm (written 0 when not finite)
     std::string sensorsCalibDate;  ///< ISO-8601 UTC, e.g. "2026-02-03T09:03:03Z"
     Connection connection;
   };
