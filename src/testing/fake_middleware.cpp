@@ -374,11 +374,12 @@ bool FakeMiddleware::Impl::write(std::string_view bytes) {
     }
     if (n < 0 && errno == EINTR) continue;
     if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK) && Clock::now() < deadline) {
-      // A client that does not read must not hold up stop().
+      // A client that does not read must not hold up stop(). Drained before the check: stop() sets
+      // `stopping` before it wakes. The other wakes are for hooks(), which run every loop anyway.
       pollfd p[2] = {{client.get(), POLLOUT, 0}, {wakePipe.fd(), POLLIN, 0}};
       ::poll(p, 2, pollMs(deadline - Clock::now()));
+      wakePipe.drain();
       if (stopping.load()) return false;  // run() closes the client on its way out
-      wakePipe.drain();                   // the other wakes are for hooks(), which run every loop
       continue;
     }
     closeClient(n < 0 ? std::string("send: ") + std::strerror(errno) : std::string("send failed"));

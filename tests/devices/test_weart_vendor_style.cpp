@@ -14,6 +14,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <thread>
 #include <variant>
 #include <vector>
 
@@ -42,7 +43,10 @@ struct Received {
 
 class ExampleClient {
  public:
-  explicit ExampleClient(std::uint16_t port) : socket_(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0)) {
+  /// `receiveBuffer`: SO_RCVBUF in bytes (0: the system's).
+  explicit ExampleClient(std::uint16_t port, int receiveBuffer = 0)
+      : socket_(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0)) {
+    if (receiveBuffer > 0) ::setsockopt(socket_.get(), SOL_SOCKET, SO_RCVBUF, &receiveBuffer, sizeof receiveBuffer);
     sockaddr_in address{};
     address.sin_family = AF_INET;
     address.sin_port = htons(port);
@@ -331,6 +335,36 @@ TEST(WeartVendorStyle, AStartErrorIsRepeatedUntilTheNextStart) {
         return s && s->status == "RUNNING" && s->statusCode == 0;
       },
       kWait));
+}
+
+// A client that stops reading blocks the fake's writes (for up to a second each); stop() must not
+// wait for them.
+TEST(WeartVendorStyle, StopIsPromptWhileWritingToAClientThatDoesNotRead) {
+  FakeMiddlewareSettings fs = settingsOf(kFlavours[1]);
+  fs.hands = {HandSide::Left, HandSide::Right};
+  fs.trackingHz = 1000.0;
+  FakeMiddleware fake(fs);
+  fake.start();
+  ExampleClient client(fake.port(), 4096);
+  ASSERT_TRUE(client.connected());
+  client.send(kPythonStart);
+  client.send(pythonRequest("RAW_DATA_ON"));
+  // Blocked: no tracking frame has gone out for 200 ms.
+  std::uint64_t sent = fake.trackingFramesSent();
+  Clock::time_point changed = Clock::now();
+  const Clock::time_point until = Clock::now() + 30s;
+  while (Clock::now() - changed < 200ms) {
+    ASSERT_LT(Clock::now(), until) << "the fake never blocked";
+    std::this_thread::sleep_for(10ms);
+    if (const std::uint64_t now = fake.trackingFramesSent(); now != sent) {
+      sent = now;
+      changed = Clock::now();
+    }
+  }
+  ASSERT_TRUE(fake.clientConnected());
+  const Clock::time_point before = Clock::now();
+  fake.stop();
+  EXPECT_LT(Clock::now() - before, 500ms) << "stop() waited for the blocked write";
 }
 
 }  // namespace
