@@ -2,10 +2,11 @@
 // A fake WEART middleware (protocol notes §11) for tests and for trying the client without a
 // glove: a TCP server on 127.0.0.1 with its own thread, one client at a time. It pushes the status
 // and device status on connect and every statusPeriod, the status also on every change (clients
-// such as the vendor's examples listen without asking), answers status requests, starts, calibrates and
-// stops sessions, streams tracking while running (G1 `Tracking`, DEFAULT after a bare start, or
-// Pro `TRACKING_BENDING_G2`) and raw data of every node after RAW_DATA_ON, and records every
-// client command with the force each thimble would press now. Test hooks break it on purpose.
+// such as the vendor's examples listen without asking), answers status requests, starts,
+// calibrates and stops sessions, streams tracking while running (G1 `Tracking`, DEFAULT after a
+// bare start, or Pro `TRACKING_BENDING_G2`) and, after RAW_DATA_ON, raw data of every node, and
+// records every client command with the force each thimble would press now. Test hooks break it
+// on purpose.
 
 #include <array>
 #include <chrono>
