@@ -172,8 +172,8 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log) {
       throw Error(fmt::format("body '{}': {}", b.name, e.what()));
     }
     body.id = world.addBody(body.model);
-    const Vec3 force = b.force + (b.kind == BodyKind::Cloth ? spec.wind : Vec3::Zero());
-    if (force != Vec3::Zero()) world.setExternalForce(body.id, force);
+    const Vec3 wind = b.kind == BodyKind::Cloth ? spec.wind : Vec3::Zero();
+    if (b.force != Vec3::Zero() || wind != Vec3::Zero()) world.setExternalForce(body.id, b.force, wind);
     if (!b.pin.empty()) {
       const auto& v = body.mesh.tets.vertices;
       const Eigen::AlignedBox3f box = boundsOf(v);

@@ -408,8 +408,7 @@ SolverSettings readSolver(const Table& t) {
 }
 
 void readModuli(const Table& t, BodyKind kind, Material& m) {
-  const int given = int(t.has("youngs")) + int(t.has("poisson")) + int(t.has("density"));
-  if (given == 0) {
+  if (!t.has("youngs") && !t.has("poisson")) {
     if (t.has("rayleigh_damping")) t.fail("rayleigh_damping", "needs youngs, poisson and density");
     return;
   }
@@ -424,6 +423,19 @@ void readModuli(const Table& t, BodyKind kind, Material& m) {
   m.elastic = e;
 }
 
+// Masses: lumped from the density (soft) or areal density (cloth), or a fixed mass per particle.
+void readMass(const Table& t, BodyKind kind, Material& m) {
+  const bool cloth = kind == BodyKind::Cloth;
+  if (cloth && t.has("density")) t.fail("density", "a cloth's masses come from areal_density (kg/m^2)");
+  if (!cloth && t.has("areal_density")) t.fail("areal_density", "a soft body's masses come from density (kg/m^3)");
+  if (t.has("particle_mass"))
+    for (std::string_view key : {"density", "areal_density"})
+      if (t.has(key)) t.fail("particle_mass", fmt::format("cannot go with {}: one of them gives the masses", key));
+  t.readNumber("density", m.density, kPositive);
+  t.readNumber("areal_density", m.arealDensity, kPositive);
+  if (std::optional<Field> f = t.get("particle_mass")) m.particleMass = f->number<float>(kPositive);
+}
+
 Material readMaterial(const Table& t, BodyKind kind) {
   static constexpr Option<ConstraintMaterial Material::*> kTypes[] = {{"distance", &Material::distance},
                                                                       {"volume", &Material::volume},
@@ -431,13 +443,14 @@ Material readMaterial(const Table& t, BodyKind kind) {
                                                                       {"strain_shear", &Material::strainShear},
                                                                       {"shape_matching", &Material::shapeMatching},
                                                                       {"bending", &Material::bending}};
-  Keys keys = {"youngs",     "poisson", "density",       "rayleigh_damping",
+  Keys keys = {"youngs",     "poisson", "density",       "areal_density",  "rayleigh_damping",
                "compliance", "damping", "particle_mass", "particle_radius"};
   for (const auto& type : kTypes) keys.push_back(type.name);
   t.allowOnly(keys);
 
   Material m;
   readModuli(t, kind, m);
+  readMass(t, kind, m);
   // The blanket values first, so that a type's own table overrides them.
   if (std::optional<Field> f = t.get("compliance"))
     for (const auto& type : kTypes) (m.*type.value).compliance = f->number<float>(kNonNegative);
@@ -449,7 +462,6 @@ Material readMaterial(const Table& t, BodyKind kind) {
     sub.readNumber("compliance", (m.*type.value).compliance, kNonNegative);
     sub.readNumber("damping", (m.*type.value).damping, kNonNegative);
   }
-  t.readNumber("particle_mass", m.particleMass, kPositive);
   t.readNumber("particle_radius", m.particleRadius, kNonNegative);
   return m;
 }

@@ -27,8 +27,14 @@ void validateMaterial(const Material& m) {
     if (!finiteNonNegative(c->damping))
       throw Error(fmt::format("material: {} damping must be finite and >= 0, got {}", name, c->damping));
   }
-  if (!(std::isfinite(m.particleMass) && m.particleMass > 0.0f))
-    throw Error(fmt::format("material: particle mass must be positive, got {}", m.particleMass));
+  const auto positive = [](float v) { return std::isfinite(v) && v > 0.0f; };
+  if (!positive(m.density)) throw Error(fmt::format("material: density must be positive, got {}", m.density));
+  if (!positive(m.arealDensity))
+    throw Error(fmt::format("material: areal density must be positive, got {}", m.arealDensity));
+  if (m.particleMass && !positive(*m.particleMass))
+    throw Error(fmt::format("material: particle mass must be positive, got {}", *m.particleMass));
+  if (m.particleMass && m.elastic)
+    throw Error("material: a particle mass cannot go with moduli (their density gives the masses)");
   if (!finiteNonNegative(m.particleRadius))
     throw Error(fmt::format("material: particle radius must be finite and >= 0, got {}", m.particleRadius));
   if (m.elastic) {
@@ -37,11 +43,17 @@ void validateMaterial(const Material& m) {
       throw Error(fmt::format("material: Young's modulus must be positive, got {}", e.youngsModulus));
     if (!(e.poissonRatio >= 0.0f && e.poissonRatio < 0.5f))
       throw Error(fmt::format("material: Poisson ratio must be in [0, 0.5), got {}", e.poissonRatio));
-    if (!(std::isfinite(e.density) && e.density > 0.0f))
-      throw Error(fmt::format("material: density must be positive, got {}", e.density));
+    if (!positive(e.density)) throw Error(fmt::format("material: density must be positive, got {}", e.density));
     if (!finiteNonNegative(e.rayleighDamping))
       throw Error(fmt::format("material: Rayleigh damping must be finite and >= 0, got {}", e.rayleighDamping));
   }
+}
+
+// The inverse of each particle's lumped mass, or of the fixed particle mass when one is given.
+std::vector<float> inverseMasses(const std::vector<double>& lumped, std::optional<float> particleMass) {
+  std::vector<float> w(lumped.size());
+  for (std::size_t v = 0; v < lumped.size(); ++v) w[v] = particleMass ? 1.0f / *particleMass : float(1.0 / lumped[v]);
+  return w;
 }
 
 float dampingTime(const ConstraintMaterial& c) { return c.compliance * c.damping; }
@@ -169,6 +181,7 @@ std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Materia
   model->particleRadius = material.particleRadius;
 
   const std::size_t n = mesh.vertices.size();
+  const double density = material.elastic ? material.elastic->density : material.density;
   std::vector<double> restVolume(model->tets.size());
   std::vector<double> lumpedMass(n, 0.0);
   std::vector<char> used(n, 0);
@@ -180,14 +193,12 @@ std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Materia
     model->restVolume += restVolume[t];
     for (Index v : tet) {
       used[v] = 1;
-      if (material.elastic) lumpedMass[v] += material.elastic->density * restVolume[t] / 4.0;
+      lumpedMass[v] += density * restVolume[t] / 4.0;
     }
   }
   for (std::size_t v = 0; v < n; ++v)
     if (!used[v]) throw Error(fmt::format("vertex {} is not used by any tet; remove unused vertices first", v));
-  model->invMass.resize(n);
-  for (std::size_t v = 0; v < n; ++v)
-    model->invMass[v] = material.elastic ? float(1.0 / lumpedMass[v]) : 1.0f / material.particleMass;
+  model->invMass = inverseMasses(lumpedMass, material.particleMass);
 
   // Elastic mapping (docs/materials.md): strain + volume energies equal linear elasticity at small strain.
   double mu = 0.0, lameLambda = 0.0;
@@ -244,7 +255,16 @@ std::shared_ptr<const BodyModel> makeCloth(const TriMesh& mesh, const Material& 
   model->restPositions = mesh.vertices;
   model->triangles = mesh.triangles;
   model->surface = mesh.triangles;
-  model->invMass.assign(mesh.vertices.size(), 1.0f / material.particleMass);
+  std::vector<double> lumpedMass(mesh.vertices.size(), 0.0);
+  for (const Triangle& t : mesh.triangles) {
+    const auto& x = mesh.vertices;
+    const double area = 0.5 * (x[t[1]] - x[t[0]]).cast<double>().cross((x[t[2]] - x[t[0]]).cast<double>()).norm();
+    for (Index v : t) lumpedMass[v] += material.arealDensity * area / 3.0;
+  }
+  for (std::size_t v = 0; v < lumpedMass.size(); ++v)
+    if (!(lumpedMass[v] > 0.0))
+      throw Error(fmt::format("vertex {} is not used by any triangle; remove unused vertices first", v));
+  model->invMass = inverseMasses(lumpedMass, material.particleMass);
   model->damping = dampingOf(material);
   model->particleRadius = material.particleRadius;
 
@@ -270,11 +290,6 @@ std::shared_ptr<const BodyModel> makeCloth(const TriMesh& mesh, const Material& 
     model->bend = permuted(model->bend, levels.order);
     model->bendLevels = levels.colourStart;
   }
-  std::vector<char> used(mesh.vertices.size(), 0);
-  for (const Triangle& t : mesh.triangles)
-    for (Index v : t) used[v] = 1;
-  for (std::size_t v = 0; v < used.size(); ++v)
-    if (!used[v]) throw Error(fmt::format("vertex {} is not used by any triangle; remove unused vertices first", v));
   return model;
 }
 

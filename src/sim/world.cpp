@@ -131,10 +131,14 @@ void World::setInverseMass(Index particle, float w) {
   particles_.x[particle].w = particles_.p[particle].w = w;
 }
 
-void World::setExternalForce(BodyId id, const Vec3& force) {
+void World::setExternalForce(BodyId id, const Vec3& force, const Vec3& perKg) {
   checkFinite(force, "setExternalForce");
+  checkFinite(perKg, "setExternalForce (per kg)");
   const Body& b = bodies_.at(id);
-  std::fill_n(particles_.force.begin() + b.firstParticle, b.particleCount, force);
+  for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
+    const float w = particles_.x[i].w;
+    particles_.force[i] = w > 0.0f ? Vec3(force + perKg / w) : force;
+  }
 }
 
 AttachmentId World::attach(Index particle, const Vec3& target, float compliance, const Vec3& axes, float damping) {

@@ -67,6 +67,16 @@ TEST(InputValidation, MaterialErrors) {
   m.particleMass = -1.0f;
   EXPECT_NE(errorOf([&] { makeSoftBody(mesh, m); }).find("mass"), std::string::npos);
   m = Material{};
+  m.density = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_NE(errorOf([&] { makeSoftBody(mesh, m); }).find("density must be positive"), std::string::npos);
+  m = Material{};
+  m.arealDensity = 0.0f;
+  EXPECT_NE(errorOf([&] { makeSoftBody(mesh, m); }).find("areal density must be positive"), std::string::npos);
+  m = Material{};
+  m.particleMass = 1.0f;
+  m.elastic = ElasticModuli{1e4f, 0.3f, 1000.0f};
+  EXPECT_NE(errorOf([&] { makeSoftBody(mesh, m); }).find("cannot go with moduli"), std::string::npos);
+  m = Material{};
   m.volume.compliance = -0.1f;
   EXPECT_NE(errorOf([&] { makeSoftBody(mesh, m); }).find("volume compliance"), std::string::npos);
   m = Material{};

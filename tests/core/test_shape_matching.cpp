@@ -30,6 +30,7 @@ struct ShapeMatchOnly {
 
   ShapeMatchOnly(const Vec3& translation, const Quat& rotation) : world(settings()) {
     Material m;
+    m.particleMass = 1.0f;  // the energy and the periods below are in unit masses
     m.shapeMatching = {1e-3f, 0.0f};
     model = makeSoftBody(makeBoxTets(Vec3(-0.5f, -0.25f, -0.1f), Vec3(1.0f, 0.5f, 0.2f), 4, 2, 1), m,
                          {false, false, false, true});

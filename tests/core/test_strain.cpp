@@ -59,6 +59,7 @@ struct HomogeneousBlock {
 
   explicit HomogeneousBlock(const Mat3& F) : world(settings()) {
     Material m;
+    m.particleMass = 1.0f;  // the paper's: the soft compliance keeps each step's excursion tiny
     m.strainStretch = {kCompliance, 0.0f};
     m.strainShear = {kCompliance, 0.0f};
     const TetMesh mesh = makeBoxTets(Vec3::Zero(), Vec3::Ones(), 3, 3, 3);

@@ -4,6 +4,7 @@
 
 #include <limits>
 
+#include "vrdeform/error.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/world.h"
 
@@ -102,6 +103,25 @@ TEST(World, ConstantForceAcceleratesByForceOverMass) {
   for (int i = 0; i < 60; ++i) w.step();
   EXPECT_NEAR(w.particles().v[0].x(), 10.0f, 1e-4f);  // 10 m/s^2 for 1 s
   EXPECT_NEAR(w.particles().v[0].y(), -9.81f, 1e-4f);
+}
+
+TEST(World, AForcePerKilogramAcceleratesLightAndHeavyParticlesAlike) {
+  // A 1 kg and a 4 kg particle and a kinematic one, 2 m/s^2 along x per kg plus 1 N each along z.
+  SolverSettings s;
+  s.gravity.setZero();
+  World w(s);
+  auto model = std::make_shared<BodyModel>();
+  model->restPositions = {Vec3::Zero(), Vec3::UnitY(), Vec3::UnitZ()};
+  model->invMass = {1.0f, 0.25f, 0.0f};
+  const BodyId b = w.addBody(model);
+  w.setExternalForce(b, Vec3(0.0f, 0.0f, 1.0f), Vec3(2.0f, 0.0f, 0.0f));
+  EXPECT_EQ(w.particles().force[1], Vec3(8.0f, 0.0f, 1.0f));
+  for (int i = 0; i < 60; ++i) w.step();
+  for (Index i : {0u, 1u}) EXPECT_NEAR(w.particles().v[i].x(), 2.0f, 1e-4f);  // 1 s
+  EXPECT_NEAR(w.particles().v[0].z(), 1.0f, 1e-4f);
+  EXPECT_NEAR(w.particles().v[1].z(), 0.25f, 1e-4f);
+  EXPECT_EQ(w.particles().v[2], Vec3::Zero());
+  EXPECT_THROW(w.setExternalForce(b, Vec3::Zero(), Vec3(std::numeric_limits<float>::infinity(), 0, 0)), Error);
 }
 
 TEST(World, MovingAttachmentArrivesAtItsGoal) {

@@ -54,7 +54,7 @@ TEST(Cloth, FlagBillowsInTheWindFromItsPole) {
   // vertical pole; a steady wind across it (+z) turns it about the pole until it streams
   // downwind (damped, so it settles instead of swinging on).
   const Flag flag = makeFlag(Vec3(0, 2, 0), 0.6f, 0.4f, 12, 8);
-  const float weight = clothMaterial().particleMass * 9.81f;
+  const float weight = *clothMaterial().particleMass * 9.81f;
   const std::vector<Vec3> x = hang(flag.cloth, flag.pinned, 4.0f, Vec3(0, 0, weight), 3.0f);
   for (Index v : flag.pinned) EXPECT_EQ(x[v], flag.cloth.vertices[v]);
   const Index farTop = 12;  // (iu, iv) = (12, 0)

@@ -258,7 +258,8 @@ TEST(SceneFile, FullSceneSetsEveryField) {
   EXPECT_FLOAT_EQ(flag.pinTolerance, 0.01f);
   const Material& fm = flag.material;
   EXPECT_FALSE(fm.elastic.has_value());
-  EXPECT_FLOAT_EQ(fm.particleMass, 0.05f);
+  ASSERT_TRUE(fm.particleMass.has_value());
+  EXPECT_FLOAT_EQ(*fm.particleMass, 0.05f);
   EXPECT_FLOAT_EQ(fm.distance.compliance, 2e-4f);
   EXPECT_FLOAT_EQ(fm.distance.damping, 0.01f);
   EXPECT_FLOAT_EQ(fm.bending.compliance, 1e-4f);
@@ -380,7 +381,8 @@ TEST(SceneFile, AbsentKeysKeepTheirDefaults) {
   EXPECT_EQ(b.constraints.strain, paper.strain);
   EXPECT_EQ(b.constraints.shapeMatching, paper.shapeMatching);
   EXPECT_FALSE(b.material.elastic.has_value());
-  EXPECT_EQ(b.material.particleMass, Material().particleMass);
+  EXPECT_FALSE(b.material.particleMass.has_value());  // masses from the density
+  EXPECT_EQ(b.material.density, Material().density);
   EXPECT_EQ(b.material.volume.compliance, Material().volume.compliance);
   EXPECT_TRUE(s.colliders.empty());
 
@@ -569,6 +571,22 @@ TEST(SceneFile, ModuliGoTogether) {
   EXPECT_EQ(errorIn("[[body]]\nkind = \"cloth\"\nmesh = \"flag_plane.obj\"\n"
                     "[body.material]\nyoungs = 1e4\npoisson = 0.3\ndensity = 1000\n"),
             "scene.toml:5: body[1].material.youngs: a cloth takes compliance and damping, not moduli");
+}
+
+TEST(SceneFile, MassesComeFromADensityOrAParticleMass) {
+  const Material soft = parse(std::string(kMinimal) + "[body.material]\ndensity = 500\n").bodies[0].material;
+  EXPECT_FALSE(soft.elastic.has_value());
+  EXPECT_FLOAT_EQ(soft.density, 500.0f);
+  const std::string cloth = "[[body]]\nkind = \"cloth\"\nmesh = \"flag_plane.obj\"\n[body.material]\n";
+  EXPECT_FLOAT_EQ(parse(cloth + "areal_density = 0.3\n").bodies[0].material.arealDensity, 0.3f);
+  EXPECT_EQ(errorIn(cloth + "density = 500\n"),
+            "scene.toml:5: body[1].material.density: a cloth's masses come from areal_density (kg/m^2)");
+  EXPECT_EQ(errorIn(std::string(kMinimal) + "[body.material]\nareal_density = 0.3\n"),
+            "scene.toml:4: body[1].material.areal_density: a soft body's masses come from density (kg/m^3)");
+  EXPECT_EQ(errorIn(std::string(kMinimal) + "[body.material]\ndensity = 500\nparticle_mass = 0.1\n"),
+            "scene.toml:5: body[1].material.particle_mass: cannot go with density: one of them gives the masses");
+  EXPECT_EQ(errorIn(std::string(kMinimal) + "[body.material]\ndensity = 0\n"),
+            "scene.toml:4: body[1].material.density: must be positive, got 0");
 }
 
 TEST(SceneFile, ActionNamingAnUnknownBody) {

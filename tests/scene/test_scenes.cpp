@@ -125,6 +125,55 @@ TEST(Scenes, TheLiversPokeIsSmoothMonotoneAndSteady) {
   testing::record("hold_noise_newtons", r.pokes[0].newtons.holdNoise);
 }
 
+double totalMass(const BodyModel& m) {
+  double kg = 0.0;
+  for (float w : m.invMass) kg += 1.0 / double(w);
+  return kg;
+}
+
+// A body without a material weighs what its volume of water weighs (it used to weigh 1 kg per
+// particle: 291 kg for the liver).
+TEST(Scenes, ABodyWithoutAMaterialWeighsItsVolumeOfWater) {
+  SceneSpec spec = loadSceneByName("liver");
+  spec.bodies[0].material = Material{};
+  spec.hand.enabled = false;
+  spec.settle = 0.0;
+  const BuiltScene scene = buildScene(spec);
+  const BodyModel& m = *scene.bodies[0].model;
+  EXPECT_NEAR(totalMass(m), 1000.0 * m.restVolume, 1e-5 * 1000.0 * m.restVolume);
+  testing::record("kg", totalMass(m));
+}
+
+// The flag weighs a light fabric's 0.2 kg/m^2 (0.3125 kg, not the paper's 841 kg), and with the
+// paper's compliances divided by its particle mass and the wind as an acceleration it moves as the
+// paper's flag does while its forces scale with the mass.
+TEST(Scenes, TheFlagWeighsAFlagsWeightAndMovesAsThePapersFlagDoes) {
+  const SceneSpec physical = loadSceneByName("flag");
+  SceneSpec paper = physical;
+  Material& m = paper.bodies[0].material;
+  m.particleMass = 1.0f;
+  m.distance.compliance = 1e-6f;
+  m.bending.compliance = 1.0f;
+  BuiltScene a = buildScene(physical), b = buildScene(paper);
+  const double kg = totalMass(*a.bodies[0].model);
+  EXPECT_NEAR(kg, 0.2 * 1.25 * 1.25, 1e-3);
+  EXPECT_NEAR(totalMass(*b.bodies[0].model), 841.0, 1e-3);
+
+  RunSettings settings;
+  settings.steps = std::uint64_t(std::lround(2.0 / physical.solver.timeStep));  // the poke
+  const RunSummary ra = runScene(a, settings), rb = runScene(b, settings);
+  double distance = 0.0;
+  const auto& pa = a.world->particles().x;
+  const auto& pb = b.world->particles().x;
+  for (std::size_t i = 0; i < pa.size(); ++i) distance += double((pa[i].pos - pb[i].pos).norm());
+  EXPECT_LT(distance / double(pa.size()), 1e-3);  // m, on a 1.25 m flag
+  const int index = int(Finger::Index);
+  ASSERT_GT(rb.newtonsMax[index], 0.0f);
+  EXPECT_NEAR(ra.newtonsMax[index] / rb.newtonsMax[index], kg / 841.0, 0.1 * kg / 841.0);
+  testing::record("poke_newtons", ra.newtonsMax[index]);
+  testing::record("paper_poke_newtons", rb.newtonsMax[index]);
+}
+
 INSTANTIATE_TEST_SUITE_P(Builtin, EveryBody, ::testing::Values("balloon", "bear", "furball", "jelly", "liver"));
 
 INSTANTIATE_TEST_SUITE_P(Builtin, EveryScene,

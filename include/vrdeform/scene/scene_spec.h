@@ -76,9 +76,11 @@ struct SceneSpec {
   std::string description;  ///< one line
   std::string source;       ///< the file it came from (absolute), or "builtin:NAME"
   SolverSettings solver;
-  Vec3 wind = Vec3::Zero();  ///< constant force on each cloth particle (N); the paper's flag uses 20 N
-  double settle = 1.0;       ///< s the bodies settle under gravity before the interaction (not in the run's time)
-  double seconds = 6.0;      ///< default length of a run after settling
+  /// Constant acceleration (m/s^2: N per kg of each particle's mass) of every cloth particle; the
+  /// paper's flag: 20 N on each 1 kg particle.
+  Vec3 wind = Vec3::Zero();
+  double settle = 1.0;   ///< s the bodies settle under gravity before the interaction (not in the run's time)
+  double seconds = 6.0;  ///< default length of a run after settling
   std::vector<BodySpec> bodies;
   std::vector<Collider> colliders;  ///< the ground is one, if wanted
   HandSpec hand;

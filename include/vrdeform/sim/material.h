@@ -1,6 +1,7 @@
 #pragma once
 // Material settings of a body: per-constraint-type compliance and damping as in the paper, or
-// Young's modulus, Poisson ratio and density mapped onto them (docs/materials.md).
+// Young's modulus, Poisson ratio and density mapped onto them (docs/materials.md), and the mass
+// density its particles' masses are lumped from.
 
 #include <optional>
 
@@ -26,7 +27,11 @@ struct ElasticModuli {
 };
 
 struct Material {
-  float particleMass = 1.0f;  ///< kg per particle when no moduli are given (the paper uses 1.0)
+  // Masses are lumped from a density: each tet gives a quarter of rho V to each corner, each cloth
+  // triangle a third of rho_A A. The paper's fixed mass per particle only when asked for.
+  float density = 1000.0f;            ///< rho (kg/m^3) of a tet mesh without moduli (moduli carry their own)
+  float arealDensity = 0.2f;          ///< rho_A (kg/m^2) of a cloth: a light fabric
+  std::optional<float> particleMass;  ///< kg per particle instead (the paper: 1 kg); not with moduli
 
   // The paper's ranges: compliance 0.2-0.4, damping 0.02-0.05.
   ConstraintMaterial distance{0.3f, 0.03f};       ///< stretch (eqs. 7-15); cloth edges and tet edges
@@ -36,7 +41,7 @@ struct Material {
   ConstraintMaterial shapeMatching{0.3f, 0.03f};  ///< p_i - g_i (eq. 28), per unit mass
   ConstraintMaterial bending{0.3f, 0.03f};        ///< dihedral angle (eq. 24)
 
-  /// Overrides particleMass and the distance, volume and strain compliances and damping.
+  /// Overrides the density and the distance, volume and strain compliances and damping.
   std::optional<ElasticModuli> elastic;
 
   float particleRadius = 0.0f;  ///< particles keep this distance from colliders (m); cloth thickness

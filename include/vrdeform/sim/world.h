@@ -81,8 +81,10 @@ class World {
   Index particleIndex(BodyId body, Index local) const { return bodies_.at(body).firstParticle + local; }
   /// Sets a particle's inverse mass; 0 makes it kinematic.
   void setInverseMass(Index particle, float w);
-  /// Applies the same constant force (N) to every particle of a body, e.g. the flag's wind.
-  void setExternalForce(BodyId id, const Vec3& force);
+  /// Applies a constant force to every particle of a body: `force` (N) to each, plus `perKg`
+  /// (m/s^2, N per kg) times the particle's mass, e.g. a wind that moves light and heavy particles
+  /// alike. Kinematic particles get none of perKg.
+  void setExternalForce(BodyId id, const Vec3& force, const Vec3& perKg = Vec3::Zero());
 
   // --- Attachments -----------------------------------------------------------------------------
   /// Holds a particle at `target` along the world axes set in `axes` (1 = held).
