@@ -49,6 +49,8 @@ int main(int argc, char** argv) {
   std::string script, logPath;
   bool pro = false;
   double disconnectAfter = 0, garbageEvery = 0, seconds = 0;
+  const vrd::weart::FakeMiddlewareSettings defaults;
+  double statusPeriod = std::chrono::duration<double>(defaults.statusPeriod).count();
   int slowReader = 0, startError = 0;
   app.add_option("--port", port, "TCP port (0: any free port; the first line says which)")
       ->check(CLI::Range(0, 65535))
@@ -57,6 +59,11 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_option("--log", logPath, "Write the command log to this file instead of stdout");
   app.add_flag("--pro", pro, "TouchDIVER Pro / WeArtApp flavour (WA_STATUS, TRACKING_BENDING_G2)");
+  app.add_option("--status-period", statusPeriod,
+                 "Push the status and device status every this many seconds, besides on connect and on "
+                 "change (0: only then)")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
   app.add_option("--disconnect-after", disconnectAfter, "Drop each client this many seconds after it connects")
       ->check(CLI::Range(0.001, 1e6));
   app.add_option("--slow-reader", slowReader, "Sleep this many milliseconds before each read")
@@ -80,6 +87,8 @@ int main(int argc, char** argv) {
     vrd::weart::FakeMiddlewareSettings settings;
     settings.port = static_cast<std::uint16_t>(port);
     settings.pro = pro;
+    // A period shorter than a millisecond still repeats: it rounds up, never to 0 (off).
+    settings.statusPeriod = std::chrono::ceil<std::chrono::milliseconds>(std::chrono::duration<double>(statusPeriod));
     if (!script.empty()) settings.tracking = vrd::weart::TrackingScript::load(script).source();
     settings.onCommand = [&log](const vrd::weart::ReceivedCommand& c) {
       log.line(c.time, vrd::weart::describe(c.command));

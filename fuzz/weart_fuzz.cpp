@@ -84,7 +84,10 @@ void middlewareReadsBack(const MiddlewareMessage& m, std::uint64_t ts) {
     for (std::size_t i = 0; i < b.devices.size(); ++i)
       require(b.devices[i].macAddress == d->devices[i].macAddress && b.devices[i].hand == d->devices[i].hand &&
               b.devices[i].batteryLevel == d->devices[i].batteryLevel &&
-              b.devices[i].nodes.size() == d->devices[i].nodes.size());
+              b.devices[i].nodes.size() == d->devices[i].nodes.size() &&
+              (!d->pro || (b.devices[i].signalStrength == d->devices[i].signalStrength &&
+                           b.devices[i].sensorsCalibDate == d->devices[i].sensorsCalibDate &&
+                           b.devices[i].connection.bluetoothConnected == d->devices[i].connection.bluetoothConnected)));
   } else if (const auto* t = std::get_if<Tracking>(&m)) {
     if (t->hands.size() == 1) {  // Pro: one hand per frame
       const ParsedMiddleware back = parseMiddlewareFrame(trackingG2Frame(t->hands[0], ts));

@@ -417,6 +417,17 @@ ParsedMiddleware parsedDevices(const Envelope& e, bool pro) {
     if (pro) {
       battery = r.object(item, "master", false);
       if (!r.error.empty()) return failed(e.type + ": " + r.error);
+      if (!r.number(item, "signalStrength", dev.signalStrength, false) ||
+          !r.string(item, "sensorsCalibDate", dev.sensorsCalibDate))
+        return failed(e.type + ": " + r.error);
+      if (const Json* link = battery ? r.object(*battery, "connection", false) : nullptr) {
+        DevicesStatus::Connection& c = dev.connection;
+        if (!r.boolean(*link, "bluetoothOn", c.bluetoothOn) ||
+            !r.boolean(*link, "bluetoothConnected", c.bluetoothConnected) || !r.boolean(*link, "wifiOn", c.wifiOn) ||
+            !r.boolean(*link, "wifiConnected", c.wifiConnected) || !r.boolean(*link, "usbConnected", c.usbConnected))
+          return failed(e.type + ": connection: " + r.error);
+      }
+      if (!r.error.empty()) return failed(e.type + ": " + r.error);
     }
     if (battery &&
         (!r.integer(*battery, "batteryLevel", dev.batteryLevel) || !r.boolean(*battery, "charging", dev.charging)))
@@ -486,8 +497,12 @@ ParsedMiddleware parsedTrackingG2(const Envelope& e) {
 ParsedMiddleware parsedRawData(const Envelope& e) {
   if (!e.data) return failed(e.type + ": no data object");
   Reader r;
-  RawData raw{e.type, HandSide::Right};
+  RawData raw{e.type, HandSide::Right, {}};
   if (!r.hand(*e.data, "handSide", raw.hand)) return failed(e.type + ": " + r.error);
+  for (int p = 0; p < kPointCount; ++p) {
+    if (r.object(*e.data, kPointKeys[p], false)) raw.points.push_back(static_cast<Point>(p));
+    if (!r.error.empty()) return failed(e.type + ": " + r.error);
+  }
   ParsedMiddleware out;
   out.message = std::move(raw);
   return out;
@@ -920,16 +935,18 @@ std::string devicesFrame(const DevicesStatus& devices, std::uint64_t timestampMs
       }
       nodes.push_back(std::move(node));
     }
-    if (devices.pro) {
+    if (devices.pro) {  // §7.8, in the order of its example
+      item["signalStrength"] = std::isfinite(dev.signalStrength) ? dev.signalStrength : 0.0;  // JSON has no NaN
+      item["sensorsCalibDate"] = dev.sensorsCalibDate;
       OrderedJson master;
       master["batteryLevel"] = dev.batteryLevel;
       master["charging"] = dev.charging;
       master["chargeCompleted"] = false;
-      master["connection"] = OrderedJson{{"bluetoothOn", true},
-                                         {"bluetoothConnected", true},
-                                         {"wifiOn", false},
-                                         {"wifiConnected", false},
-                                         {"usbConnected", false}};
+      master["connection"] = OrderedJson{{"bluetoothOn", dev.connection.bluetoothOn},
+                                         {"bluetoothConnected", dev.connection.bluetoothConnected},
+                                         {"wifiOn", dev.connection.wifiOn},
+                                         {"wifiConnected", dev.connection.wifiConnected},
+                                         {"usbConnected", dev.connection.usbConnected}};
       master["imuFault"] = false;
       master["adcFault"] = false;
       master["buttonPushed"] = false;
@@ -947,16 +964,20 @@ std::string devicesFrame(const DevicesStatus& devices, std::uint64_t timestampMs
   return jsonFrame(devices.pro ? "WEART_TD_PRO_STATUS" : "DEVICES_STATUS", timestampMs, &d);
 }
 
-std::string trackingG1Frame(const std::vector<HandTracking>& hands) {
+std::string trackingG1Frame(const std::vector<HandTracking>& hands, TrackType type) {
   auto byte = [](float v) { return static_cast<long long>(std::lround(clampTo(v, 1.0f) * 255.0f)); };
-  std::string out = "Tracking:TrackType1";
+  const bool type1 = type == TrackType::TrackType1;
+  std::string out = type1 ? "Tracking:TrackType1" : "Tracking";
   for (const HandSide side : {HandSide::Right, HandSide::Left}) {  // right hand first (§3.1)
     const auto it = std::find_if(hands.begin(), hands.end(), [side](const HandTracking& h) { return h.hand == side; });
-    std::array<long long, 4> v{};  // index, thumb, thumb abduction, middle (§7.3.2)
-    if (it != hands.end())
-      v = {byte(it->closure[static_cast<std::size_t>(Point::Index)]),
-           byte(it->closure[static_cast<std::size_t>(Point::Thumb)]), byte(it->thumbAbduction),
-           byte(it->closure[static_cast<std::size_t>(Point::Middle)])};
+    std::array<long long, 4> v{};
+    if (it != hands.end()) {
+      auto closure = [&](Point p) { return byte(it->closure[static_cast<std::size_t>(p)]); };
+      if (type1)  // index, thumb, thumb abduction, middle (§7.3.2)
+        v = {closure(Point::Index), closure(Point::Thumb), byte(it->thumbAbduction), closure(Point::Middle)};
+      else  // thumb, index, middle, palm (§7.3.1)
+        v = {closure(Point::Thumb), closure(Point::Index), closure(Point::Middle), closure(Point::Palm)};
+    }
     for (const long long x : v) {
       out += ':';
       appendInt(out, x);
@@ -981,6 +1002,22 @@ std::string trackingG2Frame(const HandTracking& hand, std::uint64_t timestampMs)
         OrderedJson{{"x", wireDouble(q[0])}, {"y", wireDouble(q[1])}, {"z", wireDouble(q[2])}, {"w", wireDouble(q[3])}};
   }
   return jsonFrame("TRACKING_BENDING_G2", timestampMs, &d);
+}
+
+std::string rawDataFrame(HandSide hand, const std::vector<RawSample>& samples, bool pro, std::uint64_t timestampMs) {
+  auto vector = [](const std::array<float, 3>& v) {
+    return OrderedJson{{"x", wireDouble(v[0])}, {"y", wireDouble(v[1])}, {"z", wireDouble(v[2])}};
+  };
+  OrderedJson d;
+  d["handSide"] = handName(hand);
+  for (const RawSample& sample : samples) {
+    OrderedJson sensor;
+    sensor["accelerometer"] = vector(sample.accelerometer);
+    sensor["gyroscope"] = vector(sample.gyroscope);
+    if (!pro) sensor["timeOfFlight"] = OrderedJson{{"distance", sample.distance}};
+    d[kPointKeys[static_cast<std::size_t>(sample.point)]] = std::move(sensor);
+  }
+  return jsonFrame(pro ? "RAW_DATA_TD_PRO" : "RAW_DATA", timestampMs, &d);
 }
 
 std::string calibrationStatusFrame(HandSide hand, int status) {

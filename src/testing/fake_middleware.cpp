@@ -49,6 +49,8 @@ std::string_view trim(std::string_view s) {
 
 std::size_t handIndex(HandSide hand) { return hand == HandSide::Left ? 0 : 1; }
 
+std::string macOf(HandSide hand) { return hand == HandSide::Left ? "FA:KE:00:00:00:01" : "FA:KE:00:00:00:02"; }
+
 }  // namespace
 
 // --- TrackingScript ------------------------------------------------------------------------------
@@ -193,8 +195,11 @@ struct FakeMiddleware::Impl {
   int connection = 0;
   FrameSplitter splitter;
   bool streaming = false;
-  Clock::time_point sessionStart{}, nextTick{};
+  Clock::time_point sessionStart{}, nextTick{}, nextStatus{};
   std::optional<Clock::time_point> calibrationDue;
+  TrackType trackType = TrackType::TrackType1;
+  int statusCode = 0;  // of the last status pushed, repeated until the status changes
+  std::string errorDesc;
 
   void wake() const { wakePipe.notify(); }
   void note(std::string_view text) const {
@@ -209,27 +214,52 @@ struct FakeMiddleware::Impl {
   void readClient();
   void onCommand(const ClientCommand& c);
   void tick();
-  MiddlewareStatus makeStatus(const std::string& s, int code = 0, std::string desc = {}) const;
+  std::vector<Point> nodes() const;
+  MiddlewareStatus makeStatus() const;
   DevicesStatus makeDevices() const;
+  std::string rawDataOf(const HandTracking& hand) const;
+  /// A status change: remembered (repeated by later pushes and answers) and pushed.
   bool pushStatus(const std::string& s, int code = 0, std::string desc = {}) {
     {
       std::lock_guard lock(mutex);
       status = s;
     }
-    return write(statusFrame(makeStatus(s, code, std::move(desc)), unixMs()));
+    statusCode = code;
+    errorDesc = std::move(desc);
+    return write(statusFrame(makeStatus(), unixMs()));
+  }
+  /// The status and the device status, unasked.
+  bool pushAll() {
+    nextStatus = Clock::now() + settings.statusPeriod;
+    return write(statusFrame(makeStatus(), unixMs()) + devicesFrame(makeDevices(), unixMs()));
   }
 };
 
-MiddlewareStatus FakeMiddleware::Impl::makeStatus(const std::string& s, int code, std::string desc) const {
+/// The nodes of each glove: the G1's three thimbles (its control unit, PALM, is not listed as one,
+/// §7.7), every point of a Pro (§7.8).
+std::vector<Point> FakeMiddleware::Impl::nodes() const {
+  if (settings.pro) return {Point::Thumb, Point::Index, Point::Middle, Point::Annular, Point::Pinky, Point::Palm};
+  return {Point::Thumb, Point::Index, Point::Middle};
+}
+
+// The Pro gloves are on BLE: WA_STATUS's connectionType and each master's connection say so alike.
+MiddlewareStatus FakeMiddleware::Impl::makeStatus() const {
   MiddlewareStatus m;
   m.pro = settings.pro;
-  m.status = s;
+  {
+    std::lock_guard lock(mutex);
+    m.status = status;
+  }
   m.version = settings.pro ? "2.0.0" : "1.4.0";
-  m.statusCode = code;
-  m.errorDesc = std::move(desc);
+  m.statusCode = statusCode;
+  m.errorDesc = errorDesc;
   m.actuationsEnabled = true;
-  for (HandSide hand : settings.hands)
-    m.connectedDevices.push_back({hand == HandSide::Left ? "FA:KE:00:00:00:01" : "FA:KE:00:00:00:02", hand});
+  for (HandSide hand : settings.hands) m.connectedDevices.push_back({macOf(hand), hand});
+  if (settings.pro) {
+    m.connectionType = settings.hands.empty() ? "NONE" : "BLE";
+    m.autoconnection = true;
+    m.deviceSelection = "PhysicalDevices";
+  }
   return m;
 }
 
@@ -238,16 +268,35 @@ DevicesStatus FakeMiddleware::Impl::makeDevices() const {
   d.pro = settings.pro;
   for (HandSide hand : settings.hands) {
     DevicesStatus::Device device;
-    device.macAddress = hand == HandSide::Left ? "FA:KE:00:00:00:01" : "FA:KE:00:00:00:02";
+    device.macAddress = macOf(hand);
     device.hand = hand;
     device.batteryLevel = 85;
-    const std::vector<Point> points = settings.pro ? std::vector<Point>{Point::Thumb,   Point::Index, Point::Middle,
-                                                                        Point::Annular, Point::Pinky, Point::Palm}
-                                                   : std::vector<Point>{Point::Thumb, Point::Index, Point::Middle};
-    for (Point p : points) device.nodes.push_back({p, true, 0, ""});
+    for (Point p : nodes()) device.nodes.push_back({p, true, 0, ""});
+    if (settings.pro) {
+      device.signalStrength = -55.0;
+      device.sensorsCalibDate = "2026-01-01T00:00:00Z";
+      device.connection.bluetoothOn = true;
+      device.connection.bluetoothConnected = true;
+    }
     d.devices.push_back(std::move(device));
   }
   return d;
+}
+
+/// RAW_DATA(_TD_PRO) of one hand: a sample from every node, and from the G1's control unit (§7.9);
+/// at rest under gravity, the time of flight following the finger's closure.
+std::string FakeMiddleware::Impl::rawDataOf(const HandTracking& hand) const {
+  std::vector<Point> points = nodes();
+  if (!settings.pro) points.push_back(Point::Palm);
+  std::vector<RawSample> samples;
+  for (Point p : points) {
+    RawSample s;
+    s.point = p;
+    s.accelerometer = {0.0f, -1.0f, 0.0f};
+    if (p != Point::Palm) s.distance = int(std::lround(60.0f - 50.0f * hand.closure[std::size_t(p)]));
+    samples.push_back(s);
+  }
+  return rawDataFrame(hand.hand, samples, settings.pro, unixMs());
 }
 
 void FakeMiddleware::Impl::run() noexcept {
@@ -263,6 +312,7 @@ void FakeMiddleware::Impl::run() noexcept {
       }
       Clock::time_point next = Clock::now() + kIdlePoll;
       if (streaming) next = std::min(next, nextTick);
+      if (settings.statusPeriod.count() > 0) next = std::min(next, nextStatus);
       if (calibrationDue) next = std::min(next, *calibrationDue);
       pollfd p[2] = {{client.get(), POLLIN, 0}, {wakePipe.fd(), POLLIN, 0}};
       ::poll(p, 2, pollMs(next - Clock::now()));
@@ -286,6 +336,8 @@ void FakeMiddleware::Impl::accept() {
   splitter.reset();
   streaming = false;
   calibrationDue.reset();
+  statusCode = 0;
+  errorDesc.clear();
   {
     std::lock_guard lock(mutex);
     connection = ++connections;
@@ -295,8 +347,7 @@ void FakeMiddleware::Impl::accept() {
     rawData = false;
   }
   note(fmt::format("client {} connected", connection));
-  // §11: push the status on connect.
-  if (pushStatus("IDLE")) write(devicesFrame(makeDevices(), unixMs()));
+  pushAll();
 }
 
 void FakeMiddleware::Impl::closeClient(std::string_view why) {
@@ -323,8 +374,12 @@ bool FakeMiddleware::Impl::write(std::string_view bytes) {
     }
     if (n < 0 && errno == EINTR) continue;
     if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK) && Clock::now() < deadline) {
-      pollfd p{client.get(), POLLOUT, 0};
-      ::poll(&p, 1, pollMs(deadline - Clock::now()));
+      // A client that does not read must not hold up stop(). Drained before the check: stop() sets
+      // `stopping` before it wakes. The other wakes are for hooks(), which run every loop anyway.
+      pollfd p[2] = {{client.get(), POLLOUT, 0}, {wakePipe.fd(), POLLIN, 0}};
+      ::poll(p, 2, pollMs(deadline - Clock::now()));
+      wakePipe.drain();
+      if (stopping.load()) return false;  // run() closes the client on its way out
       continue;
     }
     closeClient(n < 0 ? std::string("send: ") + std::strerror(errno) : std::string("send failed"));
@@ -439,6 +494,7 @@ void FakeMiddleware::Impl::onCommand(const ClientCommand& c) {
         return;
       }
       if (!pushStatus("STARTING") || !pushStatus("RUNNING")) return;
+      trackType = c.text.empty() ? TrackType::Default : TrackType::TrackType1;  // §6.1: bare start, DEFAULT
       streaming = true;
       sessionStart = nextTick = Clock::now();
       return;
@@ -460,12 +516,7 @@ void FakeMiddleware::Impl::onCommand(const ClientCommand& c) {
       return;
     case K::Request:
       if (c.text == "MW_GET_STATUS" || c.text == "WA_GET_STATUS") {
-        std::string current;
-        {
-          std::lock_guard lock(mutex);
-          current = status;
-        }
-        write(statusFrame(makeStatus(current), unixMs()));
+        write(statusFrame(makeStatus(), unixMs()));
       } else if (c.text == "DEVICES_GET_STATUS") {
         write(devicesFrame(makeDevices(), unixMs()));
       }
@@ -477,6 +528,7 @@ void FakeMiddleware::Impl::onCommand(const ClientCommand& c) {
 
 void FakeMiddleware::Impl::tick() {
   const Clock::time_point now = Clock::now();
+  if (settings.statusPeriod.count() > 0 && now >= nextStatus && !pushAll()) return;
   if (calibrationDue && now >= *calibrationDue) {
     calibrationDue.reset();
     for (HandSide hand : settings.hands) {
@@ -517,17 +569,10 @@ void FakeMiddleware::Impl::tick() {
   if (settings.pro) {
     for (const HandTracking& h : hands) frames += trackingG2Frame(h, unixMs());
   } else {
-    frames += trackingG1Frame(hands);
+    frames += trackingG1Frame(hands, trackType);
   }
-  if (raw) {
-    // §7.9 / §7.10: one RAW_DATA(_TD_PRO) per hand; the index sensor only.
-    for (HandSide hand : settings.hands) {
-      const std::string tof = settings.pro ? "" : R"(,"timeOfFlight":{"distance":42})";
-      frames += fmt::format(
-          R"({{"type":"{}","ts":{},"data":{{"handSide":"{}","index":{{"accelerometer":{{"x":0.01,"y":-0.98,"z":0.05}},"gyroscope":{{"x":0.3,"y":-1.2,"z":0.0}}{}}}}}}}~)",
-          settings.pro ? "RAW_DATA_TD_PRO" : "RAW_DATA", unixMs(), wireName(hand), tof);
-    }
-  }
+  if (raw)
+    for (const HandTracking& h : hands) frames += rawDataOf(h);
   if (write(frames)) {
     std::lock_guard lock(mutex);
     ++trackingSent;

@@ -409,6 +409,11 @@ TEST(WeartExamples, StatusFramesOfSections7_5To7_8) {
   EXPECT_EQ(pro.devices[0].batteryLevel, 90);
   ASSERT_EQ(pro.devices[0].nodes.size(), 2u);
   EXPECT_EQ(pro.devices[0].nodes[1].point, Point::Palm);
+  EXPECT_EQ(pro.devices[0].signalStrength, -60.5);
+  EXPECT_EQ(pro.devices[0].sensorsCalibDate, "2026-02-03T09:03:03Z");
+  const DevicesStatus::Connection& link = pro.devices[0].connection;
+  EXPECT_TRUE(link.bluetoothOn && link.bluetoothConnected);
+  EXPECT_FALSE(link.wifiOn || link.wifiConnected || link.usbConnected);
 }
 
 TEST(WeartExamples, RawDataFramesOfSections7_9To7_11) {
@@ -416,6 +421,7 @@ TEST(WeartExamples, RawDataFramesOfSections7_9To7_11) {
       R"({"type":"RAW_DATA","ts":1717600000500,"data":{"handSide":"RIGHT","index":{"accelerometer":{"x":0.01,"y":-0.98,"z":0.05},"gyroscope":{"x":0.3,"y":-1.2,"z":0.0},"timeOfFlight":{"distance":42}},"palm":{"accelerometer":{"x":0.0,"y":-1.0,"z":0.0},"gyroscope":{"x":0.0,"y":0.0,"z":0.0},"timeOfFlight":{"distance":0}}}}~)");
   EXPECT_EQ(raw.type, "RAW_DATA");
   EXPECT_EQ(raw.hand, HandSide::Right);
+  EXPECT_EQ(raw.points, (std::vector<Point>{Point::Index, Point::Palm}));
   EXPECT_EQ(messageOf<RawData>(R"({"type":"RAW_DATA_TD_PRO","ts":1,"data":{"handSide":"LEFT"}})").hand, HandSide::Left);
   EXPECT_EQ(messageOf<RawData>(R"({"type":"RAW_SENSOR_ON_MASK","ts":1,"data":{"handSide":"RIGHT"}})").type,
             "RAW_SENSOR_ON_MASK");
@@ -647,10 +653,25 @@ TEST(WeartRoundTrip, StatusFramesMatchTheNotesExamplesByteForByte) {
   EXPECT_EQ(statusFrame(wa, 1717600000123), kWaStatusExample);  // deviceSelection "" is written PhysicalDevices
 
   DevicesStatus devices;
-  DevicesStatus::Device glove{"AA:BB:CC:DD:EE:01", HandSide::Right, 85, false, {}};
+  DevicesStatus::Device glove;
+  glove.macAddress = "AA:BB:CC:DD:EE:01";
+  glove.batteryLevel = 85;
   for (const Point p : {Point::Thumb, Point::Index, Point::Middle}) glove.nodes.push_back({p, true, 0, ""});
   devices.devices.push_back(glove);
   EXPECT_EQ(devicesFrame(devices, 1717600000124), kDevicesStatusExample);
+
+  DevicesStatus pro;
+  pro.pro = true;
+  DevicesStatus::Device master;
+  master.macAddress = "AA:BB:CC:DD:EE:02";
+  master.hand = HandSide::Left;
+  master.batteryLevel = 90;
+  master.signalStrength = -60.5;
+  master.sensorsCalibDate = "2026-02-03T09:03:03Z";
+  master.connection.bluetoothOn = master.connection.bluetoothConnected = true;
+  for (const Point p : {Point::Thumb, Point::Palm}) master.nodes.push_back({p, true, 0, ""});
+  pro.devices.push_back(master);
+  EXPECT_EQ(devicesFrame(pro, 1717600000125), kProStatusExample);
 }
 
 TEST(WeartRoundTrip, DevicesFramesReadBack) {
@@ -658,8 +679,15 @@ TEST(WeartRoundTrip, DevicesFramesReadBack) {
     DevicesStatus sent;
     sent.pro = pro;
     for (const HandSide h : kHands) {
-      DevicesStatus::Device d{
-          h == HandSide::Left ? "AA:BB:CC:DD:EE:02" : "AA:BB:CC:DD:EE:01", h, 42, h == HandSide::Left, {}};
+      DevicesStatus::Device d;
+      d.macAddress = h == HandSide::Left ? "AA:BB:CC:DD:EE:02" : "AA:BB:CC:DD:EE:01";
+      d.hand = h;
+      d.batteryLevel = 42;
+      d.charging = h == HandSide::Left;
+      d.signalStrength = h == HandSide::Left ? -71.25 : -40.0;
+      d.sensorsCalibDate = "2026-02-03T09:03:03Z";
+      d.connection.wifiOn = d.connection.wifiConnected = h == HandSide::Left;
+      d.connection.usbConnected = h == HandSide::Right;
       for (const Point p : kPoints) d.nodes.push_back({p, p != Point::Pinky, pro ? 0 : 7, pro ? "" : "thimble error"});
       sent.devices.push_back(d);
     }
@@ -675,6 +703,13 @@ TEST(WeartRoundTrip, DevicesFramesReadBack) {
       EXPECT_EQ(got.devices[i].hand, sent.devices[i].hand);
       EXPECT_EQ(got.devices[i].batteryLevel, 42);
       EXPECT_EQ(got.devices[i].charging, sent.devices[i].charging);
+      // The Pro-only fields travel in WEART_TD_PRO_STATUS only.
+      const DevicesStatus::Device expected = pro ? sent.devices[i] : DevicesStatus::Device{};
+      EXPECT_EQ(got.devices[i].signalStrength, expected.signalStrength);
+      EXPECT_EQ(got.devices[i].sensorsCalibDate, expected.sensorsCalibDate);
+      EXPECT_EQ(got.devices[i].connection.wifiConnected, expected.connection.wifiConnected);
+      EXPECT_EQ(got.devices[i].connection.usbConnected, expected.connection.usbConnected);
+      EXPECT_EQ(got.devices[i].connection.bluetoothOn, expected.connection.bluetoothOn);
       ASSERT_EQ(got.devices[i].nodes.size(), static_cast<std::size_t>(kPointCount));
       for (std::size_t n = 0; n < got.devices[i].nodes.size(); ++n) {
         const auto& a = got.devices[i].nodes[n];
@@ -714,6 +749,44 @@ TEST(WeartRoundTrip, G1TrackingRoundsToBytes) {
                           ":0:0:0:0:" + std::to_string(b) + "~";
     ASSERT_EQ(trackingG1Frame(messageOf<Tracking>(f).hands), f);
   }
+}
+
+TEST(WeartRoundTrip, G1DefaultTrackingCarriesThumbIndexMiddlePalm) {
+  HandTracking right;
+  right.hand = HandSide::Right;
+  right.closure = {10.0f / 255.0f, 20.0f / 255.0f, 30.0f / 255.0f, 0.9f, 0.9f, 40.0f / 255.0f};
+  right.thumbAbduction = 0.9f;  // not carried
+  HandTracking left = right;
+  left.hand = HandSide::Left;
+  left.closure = {50.0f / 255.0f, 60.0f / 255.0f, 70.0f / 255.0f, 0.9f, 0.9f, 80.0f / 255.0f};
+  const std::string frame = trackingG1Frame({left, right}, TrackType::Default);
+  EXPECT_EQ(frame, "Tracking:10:20:30:40:50:60:70:80~");  // §7.3.1's example
+  const Tracking t = messageOf<Tracking>(frame);
+  ASSERT_EQ(t.hands.size(), 2u);
+  for (std::size_t h = 0; h < 2; ++h) {
+    const HandTracking& sent = h == 0 ? right : left;
+    for (const Point p : {Point::Thumb, Point::Index, Point::Middle, Point::Palm})
+      EXPECT_FLOAT_EQ(t.hands[h].closure[idx(p)], sent.closure[idx(p)]);
+    EXPECT_TRUE(std::isnan(t.hands[h].thumbAbduction));
+  }
+  EXPECT_EQ(trackingG1Frame({}, TrackType::Default), "Tracking:0:0:0:0:0:0:0:0~");
+}
+
+TEST(WeartRoundTrip, RawDataFramesReadBack) {
+  std::vector<RawSample> samples;
+  for (const Point p : kPoints)
+    samples.push_back({p, {0.01f, -0.98f, 0.05f}, {0.3f, -1.2f, 0.0f}, p == Point::Palm ? 0 : 42});
+  const std::string g1 = rawDataFrame(HandSide::Right, {samples[1], samples[5]}, false, 1717600000500);
+  // §7.9's example, byte for byte.
+  EXPECT_EQ(
+      g1,
+      R"({"type":"RAW_DATA","ts":1717600000500,"data":{"handSide":"RIGHT","index":{"accelerometer":{"x":0.01,"y":-0.98,"z":0.05},"gyroscope":{"x":0.3,"y":-1.2,"z":0.0},"timeOfFlight":{"distance":42}},"palm":{"accelerometer":{"x":0.01,"y":-0.98,"z":0.05},"gyroscope":{"x":0.3,"y":-1.2,"z":0.0},"timeOfFlight":{"distance":0}}}}~)");
+  const std::string pro = rawDataFrame(HandSide::Left, samples, true, 7);
+  EXPECT_EQ(pro.find("timeOfFlight"), std::string::npos) << pro;  // §7.10: the Pro has none
+  const auto got = messageOf<RawData>(pro);
+  EXPECT_EQ(got.type, "RAW_DATA_TD_PRO");
+  EXPECT_EQ(got.hand, HandSide::Left);
+  EXPECT_EQ(got.points, std::vector<Point>(std::begin(kPoints), std::end(kPoints)));
 }
 
 TEST(WeartRoundTrip, ProTrackingReadsBack) {
@@ -858,6 +931,15 @@ TEST(WeartParse, StatusFieldsMustHaveTheirTypes) {
                            R"({"devices":[{"macAddress":"AA","handSide":"LEFT","batteryLevel":85.5}]})",
                            R"({"devices":[{"macAddress":"AA","handSide":"LEFT","thimbles":{}}]})"})
     middlewareError(std::string(R"({"type":"DEVICES_STATUS","ts":1,"data":)") + data + "}");
+  for (const char* device :
+       {R"("signalStrength":"-60")", R"("signalStrength":true)", R"("sensorsCalibDate":20260203)",
+        R"("master":{"connection":[]})", R"("master":{"connection":{"bluetoothConnected":"true"}})"})
+    middlewareError(
+        std::string(
+            R"({"type":"WEART_TD_PRO_STATUS","ts":1,"data":{"devices":[{"macAddress":"AA","handSide":"LEFT",)") +
+        device + "}]}}");
+  for (const char* sensor : {R"("thumb":1)", R"("index":[])", R"("palm":null)"})
+    middlewareError(std::string(R"({"type":"RAW_DATA","ts":1,"data":{"handSide":"LEFT",)") + sensor + "}}");
 }
 
 TEST(WeartParse, JsonEnvelopeNeedsAnObjectWithStringTypeAndIntegerTs) {

@@ -87,12 +87,24 @@ struct DevicesStatus {
     int statusCode = 0;  ///< G1 thimbles; 0 for Pro nodes
     std::string errorDesc;
   };
+  /// The Pro master's links (§7.8 master.connection).
+  struct Connection {
+    bool bluetoothOn = false;
+    bool bluetoothConnected = false;
+    bool wifiOn = false;
+    bool wifiConnected = false;
+    bool usbConnected = false;
+  };
   struct Device {
     std::string macAddress;
     HandSide hand = HandSide::Right;
     int batteryLevel = 0;
     bool charging = false;
     std::vector<Node> nodes;
+    // WEART_TD_PRO_STATUS only (§7.8); devicesFrame writes them for a Pro, the parser reads them when sent.
+    double signalStrength = 0.0;   ///< RSSI in dBm (written 0 when not finite)
+    std::string sensorsCalibDate;  ///< ISO-8601 UTC, e.g. "2026-02-03T09:03:03Z"
+    Connection connection;
   };
   std::vector<Device> devices;
 };
@@ -121,9 +133,12 @@ struct CalibrationResult {  ///< §7.2
   HandSide hand;
   bool success;
 };
-struct RawData {  ///< RAW_DATA / RAW_DATA_TD_PRO / RAW_SENSOR_ON_MASK (§7.9-7.11): noted, not decoded further
+/// RAW_DATA / RAW_DATA_TD_PRO / RAW_SENSOR_ON_MASK (§7.9-7.11): which sensors sent a sample; the
+/// sample values are not decoded.
+struct RawData {
   std::string type;
   HandSide hand;
+  std::vector<Point> points;  ///< the point keys present (objects), in Point order
 };
 struct Exit {};        ///< "exit" (§7.12)
 struct Disconnect {};  ///< "disconnect" (§7.12)
@@ -212,11 +227,25 @@ ParsedClient parseClientFrame(std::string_view frame);
 /// message present, real booleans. Strings are written as ASCII: JSON escapes for non-ASCII and for '~' (U+007E).
 std::string statusFrame(const MiddlewareStatus& status, std::uint64_t timestampMs);
 std::string devicesFrame(const DevicesStatus& devices, std::uint64_t timestampMs);
-/// G1: Tracking:TrackType1 with both hands, closures rounded to 0-255 (§7.3.2); a hand missing
-/// from `hands` reads 0.
-std::string trackingG1Frame(const std::vector<HandTracking>& hands);
+/// The G1 `Tracking` layouts (§7.3): DEFAULT follows a bare StartFromClient, TrackType1 a start that names it.
+enum class TrackType : std::uint8_t { Default, TrackType1 };
+/// G1: `Tracking` with both hands, closures rounded to 0-255; TrackType1 (§7.3.2) carries index,
+/// thumb, thumb abduction and middle, DEFAULT (§7.3.1) thumb, index, middle and palm. A hand
+/// missing from `hands` reads 0.
+std::string trackingG1Frame(const std::vector<HandTracking>& hands, TrackType type = TrackType::TrackType1);
 /// Pro: TRACKING_BENDING_G2 for one hand (§7.4); NaN closures are sent as 0.
 std::string trackingG2Frame(const HandTracking& hand, std::uint64_t timestampMs);
+/// One sensor's sample in RAW_DATA / RAW_DATA_TD_PRO (§7.9, §7.10): accelerometer in g, gyroscope
+/// in deg/s, time-of-flight distance in mm (G1 only; the palm has no such sensor and reads 0).
+struct RawSample {
+  Point point = Point::Index;
+  std::array<float, 3> accelerometer{};
+  std::array<float, 3> gyroscope{};
+  int distance = 0;
+};
+/// RAW_DATA (G1, with timeOfFlight) or RAW_DATA_TD_PRO (Pro, without) for one hand, the samples in
+/// the order given.
+std::string rawDataFrame(HandSide hand, const std::vector<RawSample>& samples, bool pro, std::uint64_t timestampMs);
 std::string calibrationStatusFrame(HandSide hand, int status);  ///< `status` written as given
 std::string calibrationResultFrame(HandSide hand, bool success);
 

@@ -1,9 +1,12 @@
 #pragma once
 // A fake WEART middleware (protocol notes §11) for tests and for trying the client without a
 // glove: a TCP server on 127.0.0.1 with its own thread, one client at a time. It pushes the status
-// on connect, answers status requests, starts, calibrates and stops sessions, streams tracking
-// while running (G1 `Tracking` or Pro `TRACKING_BENDING_G2`), and records every client command
-// with the force each thimble would press now. Test hooks break it on purpose.
+// and device status on connect and every statusPeriod, the status also on every change (clients
+// such as the vendor's examples listen without asking), answers status requests, starts,
+// calibrates and stops sessions, streams tracking while running (G1 `Tracking`, DEFAULT after a
+// bare start, or Pro `TRACKING_BENDING_G2`) and, after RAW_DATA_ON, raw data of every node, and
+// records every client command with the force each thimble would press now. Test hooks break it
+// on purpose.
 
 #include <array>
 #include <chrono>
@@ -68,6 +71,9 @@ struct FakeMiddlewareSettings {
   std::vector<HandSide> hands{HandSide::Right};  ///< gloves connected to the fake
   double trackingHz = 100.0;                     ///< tracking (and raw data) frames per second while running
   TrackingSource tracking;                       ///< empty: every finger open
+  /// The status and device status are pushed this often while a client is connected, besides on
+  /// connect (both) and on every status change (the status); 0: only then.
+  std::chrono::milliseconds statusPeriod{250};
   /// Time between StartCalibration and its result; the result's success.
   std::chrono::milliseconds calibrationTime{20};
   bool calibrationSucceeds = true;
