@@ -16,6 +16,13 @@ double ramp(double t, double begin, double length) {
   return std::clamp((t - begin) / length, 0.0, 1.0);
 }
 
+// Progress u along a poke's profile. Minimum jerk, 10u^3 - 15u^4 + 6u^5 (Flash and Hogan 1985):
+// it starts and stops with zero velocity and acceleration, so that a poke arriving at its depth
+// does not strike the body and set it ringing under the held finger.
+double along(PokeProfile profile, double u) {
+  return profile == PokeProfile::Linear ? u : u * u * u * (10.0 + u * (6.0 * u - 15.0));
+}
+
 float mix(float a, float b, double u) { return a + float(u) * (b - a); }
 
 HandFrame parked(const Vec3& target) {
@@ -46,11 +53,11 @@ HandFrame actionFrame(const HandAction& a, float r, double t) {
   if (a.kind == ActionKind::Poke) {
     float depth = -r;
     if (t < t1)
-      depth = mix(-r, a.depth, ramp(t, t0, a.approach));
+      depth = mix(-r, a.depth, along(a.profile, ramp(t, t0, a.approach)));
     else if (t < t2)
       depth = a.depth;
     else
-      depth = mix(a.depth, -r, ramp(t, t2, a.release));
+      depth = mix(a.depth, -r, along(a.profile, ramp(t, t2, a.release)));
     f.fingertips[int(a.finger)] = Vec3(a.target.x(), centreY(depth), a.target.z());
     return f;
   }

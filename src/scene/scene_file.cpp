@@ -578,12 +578,15 @@ ActionSpec readAction(const Table& t, const HandRigSettings& rig, std::string_vi
                                                 {"little", Finger::Little}};
   static const Keys kCommon = {"type", "body", "finger", "start", "approach", "hold", "release", "depth", "offset"};
   static const Keys kGrasp = {"width", "lift"};
+  static const Keys kPoke = {"profile"};
+  static constexpr Option<PokeProfile> kProfiles[] = {{"minimum_jerk", PokeProfile::MinimumJerk},
+                                                      {"linear", PokeProfile::Linear}};
 
   ActionSpec a;
   HandAction& h = a.action;
   h.kind = t.require("type").choose(kKinds);
   const bool poke = h.kind == ActionKind::Poke;
-  t.allowOnly(poke ? kCommon : concat(kCommon, kGrasp), poke ? kGrasp : Keys{}, "a poke");
+  t.allowOnly(concat(kCommon, poke ? kPoke : kGrasp), poke ? kGrasp : kPoke, poke ? "a poke" : "a grasp");
 
   if (std::optional<Field> f = t.get("body")) {
     a.body = f->string();
@@ -607,6 +610,7 @@ ActionSpec readAction(const Table& t, const HandRigSettings& rig, std::string_vi
   t.readNumber("width", h.width, kNonNegative);
   t.readNumber("lift", h.lift, kNonNegative);
   t.readVec3("offset", a.offset);
+  t.readChoice("profile", h.profile, kProfiles);
   return a;
 }
 

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "test_support.h"
 #include "vrdeform/interact/hand_actions.h"
 
@@ -50,6 +52,26 @@ TEST(HandActions, PokeComesDownToItsDepthHoldsAndWithdraws) {
   EXPECT_GT(held.fingertips[int(Finger::Thumb)].y(), a.target.y() + 0.9f);
   EXPECT_FALSE(input.finished(0, 5.0));
   EXPECT_TRUE(input.finished(0, 5.01));
+}
+
+// Minimum jerk: 10u^3 - 15u^4 + 6u^5 of the way at the fraction u of the approach (0.1035 at a
+// quarter), arriving and leaving at zero speed; linear: u of the way, at constant speed.
+TEST(HandActions, APokeMovesAlongItsProfile) {
+  HandAction a = poke();  // approach 2 s from t = 1, release 1 s from t = 4
+  const float travel = a.depth + kRadius;
+  const auto depth = [&](const HandAction& action, double t) {
+    HandActionsInput input({action}, kRadius);
+    return depthOf(input.frame(0, t), Finger::Index, action);
+  };
+  EXPECT_NEAR(depth(a, 1.5), -kRadius + 0.103515625f * travel, 1e-6f);
+  const double dt = 1e-3;
+  const float cruise = travel / 2.0f * 1.875f;  // the profile's peak speed, at half way (m/s)
+  EXPECT_NEAR((depth(a, 2.0 + dt) - depth(a, 2.0 - dt)) / float(2 * dt), cruise, 1e-3f * cruise);
+  EXPECT_LT(std::abs(depth(a, 3.0 - dt) - depth(a, 3.0 - 2 * dt)) / float(dt), 1e-4f * cruise);  // arrives at rest
+  EXPECT_LT(std::abs(depth(a, 4.0 + 2 * dt) - depth(a, 4.0 + dt)) / float(dt), 1e-4f * cruise);  // leaves from rest
+  a.profile = PokeProfile::Linear;
+  EXPECT_NEAR(depth(a, 1.5), -kRadius + 0.25f * travel, 1e-6f);
+  EXPECT_NEAR((depth(a, 3.0 - dt) - depth(a, 3.0 - 2 * dt)) / float(dt), travel / 2.0f, 1e-3f);
 }
 
 TEST(HandActions, GraspClosesOnTheTargetLiftsAndLetsGo) {

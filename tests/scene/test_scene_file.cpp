@@ -513,6 +513,12 @@ TEST(SceneFile, KeyOfAnotherKindIsRejected) {
             "scene.toml:3: body[1].pin: does not apply to a soft body");
   EXPECT_EQ(errorIn(std::string(kMinimal) + "[[hand.action]]\ntype = \"poke\"\nlift = 0.01\n"),
             "scene.toml:5: hand.action[1].lift: does not apply to a poke");
+  EXPECT_EQ(errorIn(std::string(kMinimal) + "[[hand.action]]\ntype = \"grasp\"\nprofile = \"linear\"\n"),
+            "scene.toml:5: hand.action[1].profile: does not apply to a grasp");
+  const SceneSpec linear = parse(std::string(kMinimal) + "[[hand.action]]\ntype = \"poke\"\nprofile = \"linear\"\n");
+  EXPECT_EQ(linear.hand.actions[0].action.profile, PokeProfile::Linear);
+  EXPECT_EQ(parse(std::string(kMinimal) + "[[hand.action]]\ntype = \"poke\"\n").hand.actions[0].action.profile,
+            PokeProfile::MinimumJerk);
 }
 
 TEST(SceneFile, WrongTypeNamesBoth) {

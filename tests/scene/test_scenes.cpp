@@ -106,11 +106,15 @@ TEST_P(EveryBody, WholeRunGraspsAndKeepsItsVolume) {
   testing::record("poke_roughness_normalised", poke.force.roughness);
 }
 
-// The liver's scripted poke, which the fingertip's friction keeps from rolling the liver away
-// under the finger (without it: roughness 3.03 in newtons, hold noise 13%): one clean rise and
-// fall, a force that only rises while the finger presses, and a steady hold.
-TEST(Scenes, TheLiversPokeIsSmoothMonotoneAndSteady) {
-  BuiltScene scene = buildScene(loadSceneByName("liver"));
+// Each scene's scripted poke: one clean rise and fall, a force that only rises while the finger
+// presses, and a steady hold, in newtons and normalised. What made them rough: the liver rolled
+// away under a frictionless fingertip (roughness 3.03 in newtons, hold noise 13%), and a poke that
+// stopped dead set the jelly and the balloon ringing under the held finger (hold noise 2-2.6%),
+// which a minimum-jerk approach does not. The bear is not here yet (docs/haptics.md).
+class EveryPoke : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(EveryPoke, IsSmoothMonotoneAndSteady) {
+  BuiltScene scene = buildScene(loadSceneByName(GetParam()));
   RunSettings settings;
   settings.steps = std::uint64_t(std::lround(4.5 / scene.spec.solver.timeStep));  // the poke and 0.3 s after
   const RunSummary r = runScene(scene, settings);
@@ -120,10 +124,16 @@ TEST(Scenes, TheLiversPokeIsSmoothMonotoneAndSteady) {
     EXPECT_GE(q->loadingSpearman, 0.99);
     EXPECT_LT(q->holdNoise, 0.01);
   }
+  // The newtons trail the depth by at most a step; the normalised force adds its smoothing's
+  // (alpha_t 0.5: one step) to that.
   EXPECT_LE(r.pokes[0].newtons.lagSteps, 1);
+  EXPECT_LE(r.pokes[0].force.lagSteps, 2);
   testing::record("roughness_newtons", r.pokes[0].newtons.roughness);
+  testing::record("spearman_newtons", r.pokes[0].newtons.loadingSpearman);
   testing::record("hold_noise_newtons", r.pokes[0].newtons.holdNoise);
 }
+
+INSTANTIATE_TEST_SUITE_P(Builtin, EveryPoke, ::testing::Values("furball", "liver", "balloon", "jelly"));
 
 double totalMass(const BodyModel& m) {
   double kg = 0.0;

@@ -12,6 +12,10 @@ namespace vrd {
 
 enum class ActionKind { Poke, Grasp };
 
+/// How a poke moves between its depths: along a minimum-jerk profile, starting and stopping
+/// smoothly as a reaching hand does, or at a constant speed (an indentation test's ramp).
+enum class PokeProfile { MinimumJerk, Linear };
+
 /// One action in world coordinates, timed in simulation seconds. Depths are of a fingertip's lowest
 /// point below `target`; at rest an acting fingertip waits with its lowest point one radius above.
 struct HandAction {
@@ -19,7 +23,8 @@ struct HandAction {
   Finger finger = Finger::Index;  ///< the poking finger, or the one pinching against the thumb
   Vec3 target = Vec3::Zero();     ///< the point poked, or the middle of the pinch (on the body's top)
   double start = 0.0;             ///< s
-  /// Poke: down to `depth` in `approach`, stay `hold`, back up in `release`. Grasp: down to `depth` in
+  /// Poke: down to `depth` in `approach`, stay `hold`, back up in `release`, each move along
+  /// `profile`. Grasp: down to `depth` in
   /// the first 40% of `approach`, then close the gap in the rest; lift by `lift` in the first third
   /// of `hold`; lower by half the lift, open (2 cm wider than at the start, so the grasp lets go)
   /// and rise in three equal parts of `release`, letting the body drop the rest.
@@ -27,6 +32,7 @@ struct HandAction {
   float depth = 0.01f;  ///< m
   float width = 0.0f;   ///< grasp: gap between the fingertips' surfaces before closing (m); 0: 4 radii
   float lift = 0.0f;    ///< grasp: m
+  PokeProfile profile = PokeProfile::MinimumJerk;  ///< poke
 
   double end() const { return start + approach + hold + release; }
 };
