@@ -107,10 +107,10 @@ TEST_P(EveryBody, WholeRunGraspsAndKeepsItsVolume) {
 }
 
 // Each scene's scripted poke: one clean rise and fall, a force that only rises while the finger
-// presses, and a steady hold, in newtons and normalised. What made them rough: the liver rolled
-// away under a frictionless fingertip (roughness 3.03 in newtons, hold noise 13%), and a poke that
-// stopped dead set the jelly and the balloon ringing under the held finger (hold noise 2-2.6%),
-// which a minimum-jerk approach does not. The bear is not here yet (docs/haptics.md).
+// presses, and a steady hold, in newtons and normalised. What made them rough: round bodies rolled
+// away under a frictionless fingertip (the liver: roughness 3.03 in newtons, hold noise 13%), the
+// bear's thin parts swung under it, and a poke that stopped dead set the jelly and the balloon
+// ringing under the held finger (hold noise 2-2.6%), which a minimum-jerk approach does not.
 class EveryPoke : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(EveryPoke, IsSmoothMonotoneAndSteady) {
@@ -133,7 +133,7 @@ TEST_P(EveryPoke, IsSmoothMonotoneAndSteady) {
   testing::record("hold_noise_newtons", r.pokes[0].newtons.holdNoise);
 }
 
-INSTANTIATE_TEST_SUITE_P(Builtin, EveryPoke, ::testing::Values("furball", "liver", "balloon", "jelly"));
+INSTANTIATE_TEST_SUITE_P(Builtin, EveryPoke, ::testing::Values("furball", "liver", "balloon", "jelly", "bear"));
 
 double totalMass(const BodyModel& m) {
   double kg = 0.0;
