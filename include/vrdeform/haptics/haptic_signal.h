@@ -26,9 +26,10 @@ struct HapticSignalSettings {
   float betaVolume = 0.5f;   ///< beta_v (eq. 42); beta_v + beta_s = 1
   float betaStrain = 0.5f;   ///< beta_s (eq. 42)
   float epsilon = 1e-3f;     ///< in w_j = 1 / (d_j + epsilon), metres (eq. 42)
-  /// Smoothing factor per update (eq. 44). The paper's 0.2 trails the multipliers by about 4 steps
-  /// (67 ms at 60 Hz); 0.5 by one, with a clean source (fingertip friction) enough.
-  float alphaT = 0.5f;
+  /// Smoothing factor per update (eq. 44): the force trails the multipliers by (1 - alpha_t) /
+  /// alpha_t steps, 4 at the paper's 0.2. With a clean source (fingertip friction, smooth pokes)
+  /// little smoothing is needed, and 0.7 keeps the lag from depth to force within a step.
+  float alphaT = 0.7f;
 };
 
 /// Eq. 40 with Algorithm 2's clip (line 36): sum_i |lambda_i^C| over |N(r)| tau^C. 0 for an
