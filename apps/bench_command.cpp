@@ -202,14 +202,14 @@ json signalQualityTable(const BenchArgs& a, std::string& text) {
     for (const bool previous : {false, true}) {
       SceneSpec spec = benchScene(p.scene, a);
       if (previous) {
-        spec.hand.rig.friction = {};
         spec.haptics.settings.signal.alphaT = 0.2f;
         for (ActionSpec& action : spec.hand.actions) action.action.profile = PokeProfile::Linear;
       }
       double end = 0.0;
       for (const ActionSpec& action : spec.hand.actions)
         if (action.action.kind == ActionKind::Poke) end = action.action.end() + 0.3;
-      BuiltScene scene = buildScene(spec);
+      BuiltScene scene = buildScene(spec);  // calibrated as now
+      if (previous) scene.session.hand.friction = {};
       RunSettings run;
       run.steps = std::uint64_t(std::ceil(end / spec.solver.timeStep));
       const RunSummary r = runScene(scene, run);

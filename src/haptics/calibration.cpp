@@ -85,7 +85,12 @@ HapticCalibration calibrateHaptics(const World& original, BodyId body, const Hap
         body, 1e3f * sag, 1e3f * depth));
 
   const std::size_t count = world.fingertipContactCount(tip);
-  if (count == 0) throw Error(fmt::format("calibration: the poke made no contact with body {}", body));
+  if (count == 0)
+    throw Error(fmt::format("calibration: the poke made no contact with body {}{}", body,
+                            settings.friction.staticFriction > 0.0f
+                                ? ""
+                                : " (a frictionless fingertip can push a round body out from under it: give the "
+                                  "hand friction)"));
   HapticCalibration out;
   out.signal = base;
   out.point = point;

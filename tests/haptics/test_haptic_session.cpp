@@ -203,7 +203,11 @@ TEST(HapticSession, CalibrationRefusesAPokeThatCannotMeasure) {
   Liver liver;
   CalibrationSettings s;
   s.point = liver.top + Vec3(0, 0.5f, 0);  // in the air: never touches
-  EXPECT_NE(testing::errorOf([&] { calibrateHaptics(liver.world, liver.body, {}, s); }).find("no contact"),
+  const std::string frictionless = testing::errorOf([&] { calibrateHaptics(liver.world, liver.body, {}, s); });
+  EXPECT_NE(frictionless.find("no contact"), std::string::npos);
+  EXPECT_NE(frictionless.find("give the hand friction"), std::string::npos);  // a likely cause without it
+  s.friction = {0.8f, 0.6f};
+  EXPECT_EQ(testing::errorOf([&] { calibrateHaptics(liver.world, liver.body, {}, s); }).find("friction"),
             std::string::npos);
   World floating;  // nothing holds the body: the poke pushes it away as a whole
   floating.setSettings([] {
