@@ -1,0 +1,61 @@
+// Hertz contact: a rigid sphere of radius R pressed d into an elastic half-space needs
+// F = 4/3 E / (1 - nu^2) sqrt(R) d^(3/2). The fingertip's force in newtons (lambda / h^2 of its
+// contacts) against that, on a block much thicker than the contact radius sqrt(R d).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "vrdeform/mesh/primitives.h"
+#include "vrdeform/sim/world.h"
+
+namespace vrd {
+namespace {
+
+// A 10 x 5 x 10 cm block of 16 x 8 x 16 cells (12,288 tets), E 30 kPa, pinned at its base, no
+// gravity; a 1 cm fingertip (particles, frictionless) comes down 4 mm at its centre in 1.5 s and
+// holds. The mean force over the last half second of the hold.
+double indentationForce(float poisson, int iterations) {
+  SolverSettings s;
+  s.timeStages = false;
+  s.measureResiduals = false;
+  s.substeps = 8;
+  s.iterations = iterations;
+  s.gravity.setZero();
+  s.linearDamping = 0.0f;
+  World w(s);
+  Material m;
+  m.elastic = ElasticModuli{3e4f, poisson, 1060.0f, 0.0f};
+  const float side = 0.1f, height = 0.05f;
+  const TetMesh mesh = makeBoxTets(Vec3(-side / 2, 0, -side / 2), Vec3(side, height, side), 16, 8, 16);
+  const BodyId block = w.addBody(makeSoftBody(mesh, m));
+  for (Index i = 0; i < mesh.vertices.size(); ++i)
+    if (mesh.vertices[i].y() < 1e-6f) w.setInverseMass(w.particleIndex(block, i), 0.0f);
+  const float radius = 0.01f, depth = 0.004f;
+  const FingertipId tip = w.addFingertip(Vec3(0, height + radius, 0), radius);
+  double sum = 0.0;
+  int samples = 0;
+  for (int k = 0; k < 150; ++k) {
+    w.moveFingertip(tip, Vec3(0, height + radius - depth * std::min(1.0f, float(k) / 90.0f), 0));
+    w.step();
+    if (k >= 120) sum += -double(w.fingertipForce(tip).y()), ++samples;
+  }
+  return sum / samples;
+}
+
+double hertz(double poisson) {
+  const double radius = 0.01, depth = 0.004;
+  return 4.0 / 3.0 * 3e4 / (1.0 - poisson * poisson) * std::sqrt(radius) * std::pow(depth, 1.5);
+}
+
+// Converged (40 iterations), within 15%: the contact radius (6.3 mm) spans about one cell, so the
+// discrete contact patch is coarse (8 cells across: 1.7 x Hertz; 24 cells: 1.13 x).
+TEST(Indentation, AConvergedPokeMeetsHertz) {
+  for (float poisson : {0.3f, 0.45f}) {
+    const double expected = hertz(poisson);  // 1.11 N, 1.27 N
+    EXPECT_NEAR(indentationForce(poisson, 40), expected, 0.15 * expected) << "nu " << poisson;
+  }
+}
+
+}  // namespace
+}  // namespace vrd
