@@ -242,7 +242,7 @@ json loop(const BenchArgs& a, std::string& text) {
   text += fmt::format("{:>9} {:>10} | {:>6} {:>10} {:>9} {:>8} | {:>8} {:>8} {:>8}\n", "substeps", "iterations",
                       "steps", "achieved", "overruns", "resyncs", "p50 (ms)", "P99", "max");
   SceneSpec spec = benchScene("liver", a);
-  spec.solver.timeStep = 1e-3f;
+  spec.solver.timeStep = 1e-3;
   if (a.smoke) {  // at 1 kHz the settle and the calibration's poke take seconds
     spec.settle = 0.05;
     spec.haptics.calibrate = false;

@@ -183,7 +183,7 @@ struct Setup {
 
 SolverSettings solverSettings(const Scene& s) {
   SolverSettings settings;
-  settings.timeStep = 1.0f / float(s.rate);
+  settings.timeStep = 1.0 / double(s.rate);
   settings.substeps = s.substeps;
   settings.iterations = s.iterations;
   settings.linearDamping = s.linearDamping;

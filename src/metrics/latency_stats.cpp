@@ -3,42 +3,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cmath>
 #include <iterator>
 
 namespace vrd {
 namespace {
-
-/// Type-7 percentile of sorted, non-empty `x` at fraction `p` (see summarise()).
-double percentile(const std::vector<double>& x, double p) {
-  const double h = double(x.size() - 1) * p;
-  const std::size_t lo = std::size_t(h);
-  if (lo + 1 >= x.size()) return x.back();
-  return x[lo] + (h - double(lo)) * (x[lo + 1] - x[lo]);
-}
-
-/// summarise() on a vector it may reorder.
-SampleStats summariseInPlace(std::vector<double>& x) {
-  std::erase_if(x, [](double v) { return !std::isfinite(v); });
-  SampleStats s;
-  if (x.empty()) return s;
-  std::sort(x.begin(), x.end());
-  const double n = double(x.size());
-  double sum = 0.0;
-  for (double v : x) sum += v;
-  s.mean = sum / n;
-  // Two passes: summing squared deviations avoids the cancellation of E[x^2] - E[x]^2.
-  double squares = 0.0;
-  for (double v : x) squares += (v - s.mean) * (v - s.mean);
-  s.count = x.size();
-  s.stddev = std::sqrt(squares / n);
-  s.median = percentile(x, 0.50);
-  s.p95 = percentile(x, 0.95);
-  s.p99 = percentile(x, 0.99);
-  s.min = x.front();
-  s.max = x.back();
-  return s;
-}
 
 constexpr Phase kPhases[] = {Phase::Idle, Phase::Contact, Phase::All};
 
@@ -56,23 +24,14 @@ std::string_view phaseName(Phase p) {
 
 }  // namespace
 
-SampleStats summarise(std::span<const double> samples) {
-  std::vector<double> x(samples.begin(), samples.end());
-  return summariseInPlace(x);
-}
-
-void LatencyRecorder::reserve(std::size_t frames) {
-  for (auto& rows : rows_) rows.reserve(frames * kColumns);
-}
-
 void LatencyRecorder::add(const StageTimes& t, bool contact) {
-  auto& rows = rows_[contact ? 1 : 0];
-  rows.insert(rows.end(), t.ms.begin(), t.ms.end());
-  rows.push_back(t.totalMs());
+  auto& columns = columns_[contact ? 1 : 0];
+  for (std::size_t s = 0; s < kStageCount; ++s) columns[s].add(t.ms[s]);
+  columns[kStageCount].add(t.totalMs());
 }
 
 std::size_t LatencyRecorder::frames(Phase p) const {
-  const std::size_t idle = rows_[0].size() / kColumns, contact = rows_[1].size() / kColumns;
+  const std::size_t idle = columns_[0][kStageCount].count(), contact = columns_[1][kStageCount].count();
   return p == Phase::Idle ? idle : p == Phase::Contact ? contact : idle + contact;
 }
 
@@ -81,13 +40,10 @@ SampleStats LatencyRecorder::stage(Stage s, Phase p) const { return column(std::
 SampleStats LatencyRecorder::total(Phase p) const { return column(kStageCount, p); }
 
 SampleStats LatencyRecorder::column(std::size_t c, Phase p) const {
-  std::vector<double> x;
-  x.reserve(frames(p));
-  for (std::size_t r = 0; r < rows_.size(); ++r) {
-    if ((p == Phase::Idle && r == 1) || (p == Phase::Contact && r == 0)) continue;
-    for (std::size_t i = c; i < rows_[r].size(); i += kColumns) x.push_back(rows_[r][i]);
-  }
-  return summariseInPlace(x);
+  if (p != Phase::All) return columns_[p == Phase::Contact ? 1 : 0][c].stats();
+  RunningStats both = columns_[0][c];
+  both.merge(columns_[1][c]);
+  return both.stats();
 }
 
 std::string latencyTable(const LatencyRecorder& recorder) {

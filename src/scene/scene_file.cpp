@@ -389,7 +389,7 @@ SolverSettings readSolver(const Table& t) {
                "fuse_strain_volume", "measure_residuals", "tolerance"});
   t.exclusive("rate", "dt");
   SolverSettings s;
-  if (std::optional<Field> f = t.get("rate")) s.timeStep = 1.0f / float(f->integer(1, 100000));
+  if (std::optional<Field> f = t.get("rate")) s.timeStep = 1.0 / double(f->integer(1, 100000));
   t.readNumber("dt", s.timeStep, kPositive);
   t.readInt("substeps", s.substeps, 1, 1000);
   t.readInt("iterations", s.iterations, 1, 1000);

@@ -1,6 +1,7 @@
 #include "vrdeform/scene/scene_run.h"
 
 #include <fmt/format.h>
+#include <fmt/os.h>
 
 #include <chrono>
 #include <cmath>
@@ -33,24 +34,46 @@ std::map<std::string, std::size_t> constraintCounts(const std::vector<SceneBody>
   return n;
 }
 
+// A plot's series of a run of any length in bounded memory: every stride-th point, the stride
+// doubling (every other point kept) whenever kPlotPoints are held. The CSV files have every step.
+constexpr std::size_t kPlotPoints = 8192;
+struct ThinnedSeries {
+  PlotSeries series;
+  std::uint64_t seen = 0, stride = 1;
+
+  void add(double x, double y) {
+    if (seen++ % stride != 0) return;
+    series.x.push_back(x);
+    series.y.push_back(y);
+    if (series.x.size() < kPlotPoints) return;
+    for (std::size_t i = 0; 2 * i < kPlotPoints; ++i) {
+      series.x[i] = series.x[2 * i];
+      series.y[i] = series.y[2 * i];
+    }
+    series.x.resize(kPlotPoints / 2);
+    series.y.resize(kPlotPoints / 2);
+    stride *= 2;
+  }
+};
+
 // Per-step series for the plots: the force of each finger and of the hand against time, and during
 // pokes the poking finger's force against its depth below the target.
 struct Traces {
-  std::vector<double> time, paper;
-  std::array<std::vector<double>, kFingerCount> force;
-  std::array<PlotSeries, kFingerCount> indentation;
+  std::array<ThinnedSeries, kFingerCount> force, indentation;
+  ThinnedSeries paper;
 
   Traces() {
-    for (int f = 0; f < kFingerCount; ++f) indentation[f].label = std::string(fingerName(Finger(f)));
+    for (int f = 0; f < kFingerCount; ++f)
+      force[f].series.label = indentation[f].series.label = std::string(fingerName(Finger(f)));
+    paper.series.label = "hand (Algorithm 2)";
   }
   void add(double t, const HapticFrame& h, const HandRig& rig, const HandAction* poke) {
-    time.push_back(t);
-    paper.push_back(h.paper);
-    for (int f = 0; f < kFingerCount; ++f) force[f].push_back(h.fingers[f].force);
+    paper.add(t, h.paper);
+    for (int f = 0; f < kFingerCount; ++f) force[f].add(t, h.fingers[f].force);
     if (!poke) return;
     const float tipLow = rig.target(poke->finger).y() - rig.settings().geometry.fingertipRadius;
-    indentation[int(poke->finger)].x.push_back(1e3 * std::max(0.0f, poke->target.y() - tipLow));
-    indentation[int(poke->finger)].y.push_back(h.fingers[int(poke->finger)].newtons);
+    indentation[int(poke->finger)].add(1e3 * std::max(0.0f, poke->target.y() - tipLow),
+                                       h.fingers[int(poke->finger)].newtons);
   }
 };
 
@@ -63,9 +86,10 @@ class RunFiles {
     fs::create_directories(dir, ec);
     if (ec) throw Error(fmt::format("{}: cannot create the folder: {}", dir.string(), ec.message()));
     forces_.emplace(dir / "forces.csv", fingers);
-    stageCsv_ = "step,time_s,phase";
-    for (std::size_t s = 0; s < kStageCount; ++s) (stageCsv_ += ',') += fmt::format("{}_ms", stageName(Stage(s)));
-    stageCsv_ += ",total_ms\n";
+    stageCsv_.emplace(fmt::output_file((dir / "stage_times.csv").string()));
+    stageCsv_->print("step,time_s,phase");
+    for (std::size_t s = 0; s < kStageCount; ++s) stageCsv_->print(",{}_ms", stageName(Stage(s)));
+    stageCsv_->print(",total_ms\n");
     const double every = scene.spec.output.meshEvery;
     if (every > 0.0) {
       fs::create_directories(dir / "meshes", ec);
@@ -90,9 +114,9 @@ class RunFiles {
   void step(const BuiltScene& scene, const HapticSession* session, const StageTimes& times, std::uint64_t k, double t,
             bool contact) {
     if (session) forces_->send(sampleOf(t, session->haptics(), fingers_));
-    stageCsv_ += fmt::format("{},{:.6f},{}", k, t, contact ? "contact" : "idle");
-    for (double ms : times.ms) stageCsv_ += fmt::format(",{:.5f}", ms);
-    stageCsv_ += fmt::format(",{:.5f}\n", times.totalMs());
+    stageCsv_->print("{},{:.6f},{}", k, t, contact ? "contact" : "idle");
+    for (double ms : times.ms) stageCsv_->print(",{:.5f}", ms);
+    stageCsv_->print(",{:.5f}\n", times.totalMs());
     if (meshEvery_ > 0 && (k + 1) % meshEvery_ == 0) {
       for (Meshes& m : meshes_) {
         const Body& b = scene.world->body(m.body->id);
@@ -113,7 +137,7 @@ class RunFiles {
   void finish(const RunSummary& summary, const Traces& traces, std::vector<fs::path>& files) {
     forces_.reset();  // flushes and closes
     files.push_back("forces.csv");
-    writeFile(dir_ / "stage_times.csv", stageCsv_);
+    stageCsv_->close();
     files.push_back("stage_times.csv");
     writeFile(dir_ / "latency.csv", latencyCsv(summary.latency));
     files.push_back("latency.csv");
@@ -121,8 +145,8 @@ class RunFiles {
 
     Plot overTime{fmt::format("{}: haptic force", summary.scene), "time (s)", "force (normalised)", {}, {{0.0, 1.0}}};
     for (int f = 0; f < kFingerCount; ++f)
-      if (fingers_[f]) overTime.series.push_back({std::string(fingerName(Finger(f))), traces.time, traces.force[f]});
-    overTime.series.push_back({"hand (Algorithm 2)", traces.time, traces.paper});
+      if (fingers_[f]) overTime.series.push_back(traces.force[f].series);
+    overTime.series.push_back(traces.paper.series);
     writeSvgPlot(dir_ / "force_time.svg", overTime);
     files.push_back("force_time.svg");
 
@@ -131,8 +155,8 @@ class RunFiles {
                    "force (N)",
                    {},
                    std::nullopt};
-    for (const PlotSeries& s : traces.indentation)
-      if (!s.x.empty()) overDepth.series.push_back(s);
+    for (const ThinnedSeries& s : traces.indentation)
+      if (!s.series.x.empty()) overDepth.series.push_back(s.series);
     if (!overDepth.series.empty()) {
       writeSvgPlot(dir_ / "force_indentation.svg", overDepth);
       files.push_back("force_indentation.svg");
@@ -149,18 +173,20 @@ class RunFiles {
   fs::path dir_;
   std::array<bool, kFingerCount> fingers_;
   std::optional<CsvRecorder> forces_;
-  std::string stageCsv_;
+  std::optional<fmt::ostream> stageCsv_;  // written as the steps are made
   std::uint64_t meshEvery_ = 0;
   std::vector<Meshes> meshes_;
   std::vector<Vec3> positions_;
 };
 
-// A scripted poke's per-step samples, from its start to kPokeTail after its end.
+// A scripted poke's per-step samples, from its start to kPokeTail after its end; summed up and
+// let go once complete, so that a long script's pokes do not pile up.
 constexpr double kPokeTail = 0.3;
 struct PokeTrace {
   const HandAction* poke;
   std::vector<double> depth, newtons, force;
   std::size_t holdBegin = 0, holdEnd = 0;
+  bool done = false;
 
   // Step k began at time t (the hand's schedule); its frame is done.
   void add(double t, const HapticFrame& h, const HandRig& rig) {
@@ -202,7 +228,6 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
   }
   summary.constraints = constraintCounts(scene.bodies);
   summary.fingers = scene.spec.hand.enabled ? scene.session.hand.fingers : std::array<bool, kFingerCount>{};
-  summary.latency.reserve(std::size_t(std::min<std::uint64_t>(settings.steps, 1u << 22)));
 
   std::unique_ptr<RunFiles> files;
   Traces traces;
@@ -212,6 +237,7 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
   std::vector<PokeTrace> pokes;
   for (const HandAction& a : scene.actions)
     if (a.kind == ActionKind::Poke) pokes.push_back(PokeTrace{&a, {}, {}, {}});
+  constexpr std::size_t kEventsListed = 100;  // in summary.events; nanEvents counts them all
 
   HandInput* input = settings.input ? settings.input : scene.input.get();
   std::optional<HapticSession> session;
@@ -238,10 +264,9 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
               std::max(std::isfinite(summary.residuals[s].max) ? summary.residuals[s].max : 0.0, r.max);
         }
       summary.latency.add(times, contact);
-      for (const SimEvent& e : world.takeEvents()) {
-        ++summary.nanEvents;
-        summary.events.push_back(fmt::format("step {}: {}", e.step, e.message));
-      }
+      for (const SimEvent& e : world.takeEvents())
+        if (++summary.nanEvents <= kEventsListed)
+          summary.events.push_back(fmt::format("step {}: {}", e.step, e.message));
       double loss = 0.0;
       for (const SceneBody& b : scene.bodies)
         if (b.kind == BodyKind::Soft) loss = std::max(loss, std::abs(world.volumeLoss(b.id)));
@@ -262,18 +287,23 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
         const bool scripted = input == scene.input.get();
         traces.add(t, h, session->rig(), scripted ? pokeAt(scene.actions, double(k) * summary.dt) : nullptr);
         if (scripted)
-          for (PokeTrace& p : pokes) p.add(double(k) * summary.dt, h, session->rig());
+          for (PokeTrace& p : pokes) {
+            if (p.done) continue;
+            p.add(double(k) * summary.dt, h, session->rig());
+            if (p.complete(summary.dt)) {
+              summary.pokes.push_back(p.signal());
+              p = PokeTrace{p.poke, {}, {}, {}, 0, 0, true};
+            }
+          }
       }
       if (files) files->step(scene, session ? &*session : nullptr, times, k, t, contact);
-      if (settings.afterStep && !settings.afterStep(RunStep{k, t, session ? &*session : nullptr, loss})) break;
+      if (settings.afterStep && !settings.afterStep(RunStep{k, t, session ? &*session : nullptr, &times, loss})) break;
     }
     summary.ok = true;
   } catch (const std::exception& e) {
     summary.error = e.what();
   }
   for (HapticOutput* out : settings.outputs) out->release();
-  for (const PokeTrace& p : pokes)
-    if (p.complete(summary.dt)) summary.pokes.push_back(p.signal());
   for (std::size_t s = 0; s < kStageCount; ++s)
     if (residualSteps[s] > 0) summary.residuals[s].rms = residualRmsSum[s] / double(residualSteps[s]);
   if (summary.steps > 0) summary.iterationsMean = iterations / double(summary.steps);

@@ -20,17 +20,13 @@ double msSince(std::chrono::steady_clock::time_point t) {
 SimulationLoop::SimulationLoop(BuiltScene& scene, SimulationLoopSettings settings)
     : scene_(scene), settings_(std::move(settings)) {
   World& world = *scene_.world;
-  dt_ = double(world.settings().timeStep);
+  dt_ = world.settings().timeStep;
   if (!(dt_ >= 0.999e-4 && dt_ <= 1.0))
     throw Error(fmt::format("simulation loop: the scene's rate {:g} Hz is outside [1, 10000]", 1.0 / dt_));
   input_ = settings_.input ? settings_.input : scene_.input.get();
   if (scene_.spec.hand.enabled) session_.emplace(world, scene_.session, input_ ? input_->frame(0, 0.0) : HandFrame{});
   particles_ = world.particles().size();
   bodies_ = world.bodyCount();
-  std::size_t frames = settings_.latencyFrames;
-  if (settings_.maxSteps > 0) frames = std::size_t(std::min<std::uint64_t>(frames, settings_.maxSteps));
-  latency_.reserve(frames);
-  stepMs_.reserve(frames);
 }
 
 SimulationLoop::~SimulationLoop() {
@@ -87,7 +83,7 @@ LoopStats SimulationLoop::stats() const {
   if (s.steps > 0) s.wallSeconds = std::chrono::duration<double>(end_ - firstStart_).count();
   const double span = std::chrono::duration<double>(lastStart_ - firstStart_).count();
   if (s.steps > 1 && span > 0.0) s.achievedRate = double(s.steps - 1) / span;
-  s.stepMs = summarise(stepMs_);
+  s.stepMs = stepMs_.stats();
   return s;
 }
 
@@ -115,7 +111,7 @@ void SimulationLoop::pickUpChannels() {
 
 void SimulationLoop::setSolverSettings(const SolverSettings& settings) {
   SolverSettings s = settings;
-  s.timeStep = float(dt_);  // the loop's rate and the scene's calibration belong to it
+  s.timeStep = dt_;  // the loop's rate and the scene's calibration belong to it
   validateSolverSettings(s);
   std::lock_guard lock(solverMutex_);
   pendingSolver_ = s;
@@ -172,7 +168,7 @@ void SimulationLoop::run() {
       step(k);
       publish(k, msSince(lastStart_));
       const double workMs = msSince(lastStart_);
-      if (stepMs_.size() < settings_.latencyFrames) stepMs_.push_back(workMs);
+      stepMs_.add(workMs);
       if (workMs > periodMs) overruns_.fetch_add(1, std::memory_order_relaxed);
       steps_.store(k + 1, std::memory_order_release);
       ++k;
@@ -203,7 +199,7 @@ void SimulationLoop::step(std::uint64_t k) {
     world.step();
     contact_ = false;
   }
-  if (k < settings_.latencyFrames) latency_.add(session_ ? session_->times() : world.lastStep().times, contact_);
+  latency_.add(session_ ? session_->times() : world.lastStep().times, contact_);
 }
 
 void SimulationLoop::publish(std::uint64_t k, double stepWallMs) {

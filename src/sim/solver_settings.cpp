@@ -38,7 +38,7 @@ const char* simdName(SimdLevel level) {
 }
 
 void validateSolverSettings(const SolverSettings& s) {
-  if (!(std::isfinite(s.timeStep) && s.timeStep > 0.0f))
+  if (!(std::isfinite(s.timeStep) && s.timeStep > 0.0))
     throw Error(fmt::format("solver: time step must be positive, got {}", s.timeStep));
   if (s.substeps < 1) throw Error(fmt::format("solver: substeps must be >= 1, got {}", s.substeps));
   if (s.iterations < 1) throw Error(fmt::format("solver: iterations must be >= 1, got {}", s.iterations));

@@ -120,7 +120,7 @@ TEST(InputValidation, HandBuiltModelErrorsNameTheItem) {
 
 TEST(InputValidation, SettingsAndApiArguments) {
   SolverSettings s;
-  s.timeStep = 0.0f;
+  s.timeStep = 0.0;
   EXPECT_NE(errorOf([&] { World w(s); }).find("time step"), std::string::npos);
   s = SolverSettings{};
   s.timeStep = std::numeric_limits<float>::quiet_NaN();

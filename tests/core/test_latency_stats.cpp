@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <limits>
 #include <numeric>
+#include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -79,9 +81,107 @@ StageTimes frame(double predict, double force) {
   return t;
 }
 
+// Step-time-like samples: log-normal around 0.3 ms, one in fifty a spike near 5 ms (so that P99 is
+// among the spikes, not in the gap below them) and one in fifty a stage that did not run (0).
+std::vector<double> stepTimes(std::size_t n, unsigned seed) {
+  std::mt19937_64 random(seed);
+  std::lognormal_distribution<double> typical(std::log(0.3), 0.4), spike(std::log(5.0), 0.2);
+  std::uniform_int_distribution<int> kind(0, 99);
+  std::vector<double> x(n);
+  for (double& v : x) {
+    const int k = kind(random);
+    v = k <= 1 ? spike(random) : k <= 3 ? 0.0 : typical(random);
+  }
+  return x;
+}
+
+RunningStats streamOf(std::span<const double> x) {
+  RunningStats r;
+  for (double v : x) r.add(v);
+  return r;
+}
+
+void expectSame(const SampleStats& a, const SampleStats& b) {
+  EXPECT_EQ(a.count, b.count);
+  for (auto m : {&SampleStats::mean, &SampleStats::median, &SampleStats::stddev, &SampleStats::p95, &SampleStats::p99,
+                 &SampleStats::min, &SampleStats::max})
+    EXPECT_DOUBLE_EQ(a.*m, b.*m);
+}
+
+TEST(RunningStats, IsSummariseWhileFewerThanItsExactSamples) {
+  const std::vector<double> x = stepTimes(RunningStats::kExactSamples - 1, 1);
+  expectSame(streamOf(x).stats(), summarise(x));
+  std::vector<double> withNaN = x;
+  withNaN.insert(withNaN.begin() + 10, {kNaN, std::numeric_limits<double>::infinity()});
+  expectSame(streamOf(withNaN).stats(), summarise(x));  // left out, as by summarise()
+  EXPECT_EQ(RunningStats().stats().count, 0u);
+  EXPECT_TRUE(std::isnan(RunningStats().stats().p99));
+}
+
+TEST(RunningStats, AMillionSamplesKeepEveryPercentileWithinABucket) {
+  const std::vector<double> x = stepTimes(1'000'000, 2);
+  const SampleStats streamed = streamOf(x).stats(), exact = summarise(x);
+  EXPECT_EQ(streamed.count, exact.count);
+  EXPECT_EQ(streamed.min, exact.min);
+  EXPECT_EQ(streamed.max, exact.max);
+  EXPECT_NEAR(streamed.mean, exact.mean, 1e-9 * exact.mean);  // running sums: rounding only
+  EXPECT_NEAR(streamed.stddev, exact.stddev, 1e-9 * exact.stddev);
+  // A percentile lies in the bucket of its rank: at most one bucket's width, 2^(1/64) - 1, away.
+  const double width = std::exp2(1.0 / RunningStats::kBucketsPerOctave) - 1.0;
+  for (auto m : {&SampleStats::median, &SampleStats::p95, &SampleStats::p99}) {
+    EXPECT_NEAR(streamed.*m, exact.*m, width * exact.*m);
+    EXPECT_NE(streamed.*m, exact.*m);  // from the histogram, not the samples
+  }
+}
+
+TEST(RunningStats, AStageThatNeverRanStaysZeroAndOutliersStayInRange) {
+  RunningStats zeros, wide;
+  for (int i = 0; i < 10'000; ++i) {
+    zeros.add(0.0);
+    wide.add(i % 2 ? 1e-9 : 1e9);  // below and above the histogram's range
+  }
+  EXPECT_EQ(zeros.stats().median, 0.0);
+  EXPECT_EQ(zeros.stats().p99, 0.0);
+  EXPECT_EQ(wide.stats().median, 1e-9);
+  EXPECT_EQ(wide.stats().p99, 1e9);
+}
+
+TEST(RunningStats, MergedStreamsSummariseAsOne) {
+  const std::vector<double> x = stepTimes(10'000, 3);
+  const std::span<const double> all(x);
+  // Both still exact: exactly summarise() of both.
+  RunningStats a = streamOf(all.first(100));
+  a.merge(streamOf(all.subspan(100, 200)));
+  expectSame(a.stats(), summarise(all.first(300)));
+  // One exact and one histogram: the histogram of the one stream.
+  RunningStats b = streamOf(all.first(500)), whole = streamOf(all);
+  b.merge(streamOf(all.subspan(500)));
+  const SampleStats merged = b.stats(), one = whole.stats();
+  EXPECT_EQ(merged.count, one.count);
+  EXPECT_EQ(merged.median, one.median);
+  EXPECT_EQ(merged.p99, one.p99);
+  EXPECT_NEAR(merged.mean, one.mean, 1e-12 * one.mean);
+  EXPECT_NEAR(merged.stddev, one.stddev, 1e-12 * one.stddev);
+  RunningStats empty;
+  empty.merge(whole);
+  expectSame(empty.stats(), one);
+}
+
+TEST(LatencyRecorder, KeepsEveryFrameOfALongRunInFixedMemory) {
+  // Past the exact samples both phases and their union come from the histograms.
+  LatencyRecorder r;
+  const std::vector<double> x = stepTimes(100'000, 4);
+  for (std::size_t i = 0; i < x.size(); ++i) r.add(frame(x[i], 0.0), i % 4 == 0);
+  EXPECT_EQ(r.frames(Phase::Idle), 75'000u);
+  EXPECT_EQ(r.frames(Phase::Contact), 25'000u);
+  const SampleStats all = r.stage(Stage::Predict, Phase::All), exact = summarise(x);
+  EXPECT_EQ(all.count, x.size());
+  EXPECT_NEAR(all.p99, exact.p99, 0.011 * exact.p99);
+  EXPECT_NEAR(r.total(Phase::All).mean, exact.mean, 1e-9 * exact.mean);
+}
+
 TEST(LatencyRecorder, SplitsIdleAndContactFrames) {
   LatencyRecorder r;
-  r.reserve(8);
   for (int i = 1; i <= 4; ++i) r.add(frame(i, 0.0), false);        // idle predict 1..4
   for (int i = 1; i <= 3; ++i) r.add(frame(10.0 * i, 1.0), true);  // contact predict 10, 20, 30
   EXPECT_EQ(r.frames(Phase::Idle), 4u);

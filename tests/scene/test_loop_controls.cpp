@@ -22,7 +22,7 @@ using namespace std::chrono_literals;
 
 BuiltScene liver() {
   SceneSpec spec = loadSceneByName("liver");
-  spec.solver.timeStep = 1e-3f;
+  spec.solver.timeStep = 1e-3;
   spec.settle = 0.0;
   spec.haptics.calibrate = false;
   spec.solver.substeps = 1;
@@ -112,7 +112,7 @@ TEST(LoopControls, SolverSettingsChangeBetweenSteps) {
   SolverSettings s = scene.spec.solver;
   s.iterations = 7;
   s.substeps = 3;
-  s.timeStep = 0.5f;  // ignored: the loop keeps its rate
+  s.timeStep = 0.5;  // ignored: the loop keeps its rate
   loop.setSolverSettings(s);
   s.iterations = 0;
   EXPECT_THROW(loop.setSolverSettings(s), Error);  // refused at once, on this thread
@@ -121,7 +121,7 @@ TEST(LoopControls, SolverSettingsChangeBetweenSteps) {
   loop.stop();
   EXPECT_EQ(scene.world->settings().iterations, 7);
   EXPECT_EQ(scene.world->settings().substeps, 3);
-  EXPECT_EQ(scene.world->settings().timeStep, 1e-3f);
+  EXPECT_EQ(scene.world->settings().timeStep, 1e-3);
 }
 
 TEST(LoopControls, LiveHandMovesTheFingertipsFromAnotherThread) {

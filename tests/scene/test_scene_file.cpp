@@ -200,7 +200,7 @@ TEST(SceneFile, FullSceneSetsEveryField) {
   EXPECT_EQ(s.seconds, 3.0);
   EXPECT_EQ(s.wind, Vec3(20, 0, 1.5f));
 
-  EXPECT_FLOAT_EQ(s.solver.timeStep, 1.0f / 120.0f);
+  EXPECT_DOUBLE_EQ(s.solver.timeStep, 1.0 / 120.0);
   EXPECT_EQ(s.solver.substeps, 4);
   EXPECT_EQ(s.solver.iterations, 8);
   EXPECT_EQ(s.solver.gravity, Vec3(0, -9.8f, 0.5f));
@@ -409,7 +409,7 @@ TEST(SceneFile, AbsentKeysKeepTheirDefaults) {
 
 TEST(SceneFile, DtSetsTheTimeStepAndIntegersServeAsFloats) {
   const SceneSpec s = parse(std::string(kMinimal) + "[solver]\ndt = 0.002\nlinear_damping = 1\n");
-  EXPECT_FLOAT_EQ(s.solver.timeStep, 0.002f);
+  EXPECT_DOUBLE_EQ(s.solver.timeStep, 0.002);
   EXPECT_EQ(s.solver.linearDamping, 1.0f);
 }
 

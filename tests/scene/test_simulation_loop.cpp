@@ -203,19 +203,6 @@ TEST(SimulationLoop, AsFastAsPossibleRunsExactlyMaxSteps) {
   testing::record("achieved_rate_hz", stats.achievedRate);
 }
 
-TEST(SimulationLoop, LatencyCoversTheFirstLatencyFramesSteps) {
-  BuiltScene scene = liver();
-  SimulationLoopSettings s = flatOut(40);
-  s.latencyFrames = 25;
-  SimulationLoop loop(scene, s);
-  loop.start();
-  ASSERT_TRUE(finishes(loop, 60.0));
-  loop.stop();
-  EXPECT_EQ(loop.steps(), 40u);
-  EXPECT_EQ(loop.latency().frames(Phase::All), 25u);
-  EXPECT_EQ(loop.stats().stepMs.count, 25u);
-}
-
 TEST(SimulationLoop, SnapshotsArriveWithIncreasingStepNumbers) {
   BuiltScene scene = liver();
   SimulationLoop loop(scene, flatOut(300));

@@ -66,7 +66,7 @@ UniaxialResult runUniaxial(float nu, bool volumeConstraints, int cells, int iter
   const auto model = makeSoftBody(makeBoxTets(Vec3::Zero(), Vec3::Constant(kL), cells, cells, cells), material,
                                   ConstraintSet{false, volumeConstraints, true, false});
   SolverSettings settings;
-  settings.timeStep = 1.0f / 60.0f;
+  settings.timeStep = 1.0 / 60.0;
   settings.substeps = 1;
   settings.iterations = iterations;
   settings.gravity = Vec3::Zero();

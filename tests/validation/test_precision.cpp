@@ -45,7 +45,7 @@ struct PendulumRun {
 PendulumRun swing(int substeps, const Vec3& pivot, double seconds) {
   constexpr double kLength = 1.0, kTheta0 = 5.0 * kPi / 180.0;
   SolverSettings s;
-  s.timeStep = 1.0f / 60.0f;
+  s.timeStep = 1.0 / 60.0;
   s.substeps = substeps;
   s.iterations = 1;
   s.gravity = Vec3(0.0f, -float(kG), 0.0f);
@@ -146,7 +146,7 @@ TEST(Precision, ABodyOneHundredMetresAwayMovesAndPushesBackAsAtTheOrigin) {
 TEST(Precision, ARestingParticleReadsItsWeightAtAnyHeight) {
   for (float height : {0.0f, 1.0f, 10.0f, 100.0f, 1000.0f}) {
     SolverSettings s;
-    s.timeStep = 1e-3f;
+    s.timeStep = 1e-3;
     s.substeps = 8;
     s.iterations = 1;
     s.linearDamping = 0.0f;

@@ -122,7 +122,7 @@ Release release(const std::function<Vec3(const Vec3&)>& map, int substeps) {
   const auto model = makeSoftBody(makeBoxTets(Vec3::Constant(-0.05f), Vec3::Constant(0.1f), 4, 4, 4), elasticMaterial(),
                                   ConstraintSet::paper());
   SolverSettings settings;
-  settings.timeStep = 1.0f / 60.0f;
+  settings.timeStep = 1.0 / 60.0;
   settings.substeps = substeps;
   settings.iterations = 5;
   settings.gravity = Vec3::Zero();
@@ -225,7 +225,7 @@ TEST(Robustness, SliverSlabRestsStill) {
   ASSERT_LT(minDihedralDegrees(mesh), 5.0) << "not a sliver mesh";
   const auto model = makeSoftBody(mesh, elasticMaterial(), ConstraintSet::paper());
   SolverSettings settings;
-  settings.timeStep = 1.0f / 60.0f;
+  settings.timeStep = 1.0 / 60.0;
   settings.substeps = 10;
   settings.iterations = 5;
   World world(settings);

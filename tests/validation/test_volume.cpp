@@ -70,7 +70,7 @@ std::shared_ptr<const BodyModel> incompressibleCube() {
 
 SolverSettings settings20() {
   SolverSettings s;
-  s.timeStep = 1.0f / 60.0f;
+  s.timeStep = 1.0 / 60.0;
   s.substeps = 20;
   s.iterations = 5;
   return s;

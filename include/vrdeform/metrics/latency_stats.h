@@ -3,34 +3,12 @@
 
 #include <array>
 #include <cstddef>
-#include <limits>
-#include <span>
 #include <string>
-#include <vector>
 
+#include "vrdeform/metrics/sample_stats.h"
 #include "vrdeform/metrics/stage_times.h"
 
 namespace vrd {
-
-/// Summary of a set of samples. With no usable samples (as constructed), count is 0 and every value NaN.
-struct SampleStats {
-  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  std::size_t count = 0;  ///< samples used (non-finite samples are left out)
-  double mean = kNaN;     ///< arithmetic mean
-  double median = kNaN;   ///< 50th percentile
-  double stddev = kNaN;   ///< population standard deviation (divides by count)
-  double p95 = kNaN;      ///< 95th percentile
-  double p99 = kNaN;      ///< 99th percentile
-  double min = kNaN;      ///< smallest sample
-  double max = kNaN;      ///< largest sample
-};
-
-/// Summarises `samples`, leaving out NaN (and infinities: no timing is infinite, and one would
-/// poison the mean and deviation). Percentiles interpolate linearly between closest ranks
-/// (Hyndman-Fan type 7, numpy's default): with the n samples sorted as x[0..n-1], the p-th
-/// percentile is x[h] read at h = (n - 1) p, interpolating between x[floor h] and x[floor h + 1].
-/// So 1..100 gives median 50.5, P95 95.05, P99 99.01.
-SampleStats summarise(std::span<const double> samples);
 
 /// Which frames a statistic covers.
 enum class Phase {
@@ -39,12 +17,11 @@ enum class Phase {
   All       ///< both
 };
 
-/// Per-stage times of many frames, kept apart for idle and contact frames. Adding a frame does not
-/// allocate while the frames fit what reserve() asked for.
+/// Per-stage times of any number of frames, kept apart for idle and contact frames, in fixed memory
+/// (RunningStats: percentiles exact for the first frames of each phase, then within 1.1%). Adding
+/// a frame never allocates.
 class LatencyRecorder {
  public:
-  /// Room for `frames` frames in each of the idle and contact series.
-  void reserve(std::size_t frames);
   /// Records one frame's per-stage times and their total (t.totalMs()).
   void add(const StageTimes& t, bool contact);
 
@@ -54,11 +31,11 @@ class LatencyRecorder {
   std::size_t frames(Phase p) const;
 
  private:
-  /// One row per frame: kStageCount stage times, then the total.
+  /// Per phase (idle, contact): each stage's times, then the totals.
   static constexpr std::size_t kColumns = kStageCount + 1;
   SampleStats column(std::size_t c, Phase p) const;
 
-  std::array<std::vector<double>, 2> rows_;  ///< idle, contact; row-major, kColumns per frame
+  std::array<std::array<RunningStats, kColumns>, 2> columns_;
 };
 
 /// Plain-text table in the layout of the paper's Table 3: an Idle block and a Contact block, each

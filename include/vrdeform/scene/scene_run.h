@@ -24,6 +24,7 @@ struct RunStep {
   std::uint64_t step = 0;                  ///< 0-based, counted from the end of settling
   double time = 0.0;                       ///< s since the end of settling, at the end of this step
   const HapticSession* session = nullptr;  ///< null in a scene without a hand
+  const StageTimes* times = nullptr;       ///< this step's, per stage
   double volumeLoss = 0.0;                 ///< largest over the soft bodies, this step
 };
 
@@ -60,8 +61,8 @@ struct RunSummary {
   /// steps' RMS and the largest max; NaN for stages not measured.
   std::array<Residual, kStageCount> residuals;
   double iterationsMean = 0.0;  ///< Gauss-Seidel iterations per step
-  std::uint64_t nanEvents = 0;  ///< bodies frozen or particles reset after a NaN
-  std::vector<std::string> events;
+  std::uint64_t nanEvents = 0;     ///< bodies frozen or particles reset after a NaN
+  std::vector<std::string> events;  ///< what the first 100 of them were
   LatencyRecorder latency;  ///< per step: idle (no finger touching, no grasp) or contact
   double wallSeconds = 0.0;
   bool ok = false;

@@ -32,9 +32,6 @@ struct SimulationLoopSettings {
   /// Receive each step's signal on the loop thread (they never block, by contract); released when
   /// the loop ends for any reason.
   std::vector<HapticOutput*> outputs;
-  /// Steps kept for latency() and LoopStats::stepMs: the first ones, reserved up front so that
-  /// recording never allocates (112 bytes per step and phase).
-  std::size_t latencyFrames = std::size_t(1) << 16;
 };
 
 /// How a loop kept its rate.
@@ -46,7 +43,7 @@ struct LoopStats {
   std::uint64_t resyncs = 0;
   double achievedRate = 0.0;  ///< (steps - 1) / (start of the last step - start of the first) (Hz)
   double wallSeconds = 0.0;   ///< start of the first step to the end of the last
-  SampleStats stepMs;         ///< wall time of each recorded step's work, publishing included (ms)
+  SampleStats stepMs;         ///< wall time of each step's work, publishing included (ms)
 };
 
 class SimulationLoop {
@@ -74,8 +71,7 @@ class SimulationLoop {
   void stop();
   /// The loop's exception, after stop(); null when there was none (and while running).
   std::exception_ptr error() const;
-  /// Latency statistics per stage, idle and contact, of the first latencyFrames steps. After
-  /// stop() only: throws vrd::Error while started and not stopped.
+  /// Latency statistics per stage, idle and contact, of every step. After stop() only: throws vrd::Error while started and not stopped.
   const LatencyRecorder& latency() const;
   /// After stop() only, as latency().
   LoopStats stats() const;
@@ -126,7 +122,7 @@ class SimulationLoop {
 
   BuiltScene& scene_;
   SimulationLoopSettings settings_;
-  double dt_;  // the world's time step, as the world has it (float)
+  double dt_;  // the world's time step
   HandInput* input_;
   std::optional<HapticSession> session_;
   std::size_t particles_, bodies_;  // the world's, fixed while the loop exists (subscribe() reads them)
@@ -147,7 +143,7 @@ class SimulationLoop {
 
   // Loop thread while running; the controlling thread after the join.
   LatencyRecorder latency_;
-  std::vector<double> stepMs_;
+  RunningStats stepMs_;
   bool contact_ = false;  // this step's latency phase
   std::uint64_t resyncs_ = 0;
   Clock::time_point firstStart_, lastStart_, end_;

@@ -29,7 +29,9 @@ SimdLevel resolveSimd(SimdLevel level);
 const char* simdName(SimdLevel level);  ///< "off", "sse", "avx2", "avx512" or "best"
 
 struct SolverSettings {
-  float timeStep = 1.0f / 60.0f;  ///< dt of one step (s); the paper uses 1/60
+  /// dt of one step (s); the paper uses 1/60. In double so that step k's time, k dt, is exact
+  /// over hours (the solver works in float substeps).
+  double timeStep = 1.0 / 60.0;
   int substeps = 1;               ///< n: each step runs n substeps of h = dt/n ("small steps")
   int iterations = 5;             ///< Gauss-Seidel iterations per substep; the paper uses 5
   Vec3 gravity{0.0f, -9.81f, 0.0f};
@@ -59,7 +61,7 @@ struct SolverSettings {
   /// `iterations` times; the step reports how many it ran. 0: always `iterations`.
   float tolerance = 0.0f;
 
-  float substepSize() const { return timeStep / float(substeps); }
+  float substepSize() const { return float(timeStep / substeps); }
 };
 
 /// Throws vrd::Error for a non-positive or non-finite time step, substeps or iterations < 1,
