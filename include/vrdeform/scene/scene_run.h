@@ -60,10 +60,10 @@ struct RunSummary {
   /// How converged the steps were, per constraint stage (StepReport::residuals): the mean of the
   /// steps' RMS and the largest max; NaN for stages not measured.
   std::array<Residual, kStageCount> residuals;
-  double iterationsMean = 0.0;  ///< Gauss-Seidel iterations per step
-  std::uint64_t nanEvents = 0;     ///< bodies frozen or particles reset after a NaN
+  double iterationsMean = 0.0;      ///< Gauss-Seidel iterations per step
+  std::uint64_t nanEvents = 0;      ///< bodies frozen or particles reset after a NaN
   std::vector<std::string> events;  ///< what the first 100 of them were
-  LatencyRecorder latency;  ///< per step: idle (no finger touching, no grasp) or contact
+  LatencyRecorder latency;          ///< per step: idle (no finger touching, no grasp) or contact
   double wallSeconds = 0.0;
   bool ok = false;
   std::string error;

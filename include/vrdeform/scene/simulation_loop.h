@@ -71,7 +71,8 @@ class SimulationLoop {
   void stop();
   /// The loop's exception, after stop(); null when there was none (and while running).
   std::exception_ptr error() const;
-  /// Latency statistics per stage, idle and contact, of every step. After stop() only: throws vrd::Error while started and not stopped.
+  /// Latency statistics per stage, idle and contact, of every step. After stop() only: throws vrd::Error while started
+  /// and not stopped.
   const LatencyRecorder& latency() const;
   /// After stop() only, as latency().
   LoopStats stats() const;

@@ -32,8 +32,8 @@ struct SolverSettings {
   /// dt of one step (s); the paper uses 1/60. In double so that step k's time, k dt, is exact
   /// over hours (the solver works in float substeps).
   double timeStep = 1.0 / 60.0;
-  int substeps = 1;               ///< n: each step runs n substeps of h = dt/n ("small steps")
-  int iterations = 5;             ///< Gauss-Seidel iterations per substep; the paper uses 5
+  int substeps = 1;    ///< n: each step runs n substeps of h = dt/n ("small steps")
+  int iterations = 5;  ///< Gauss-Seidel iterations per substep; the paper uses 5
   Vec3 gravity{0.0f, -9.81f, 0.0f};
   /// Velocity damping c (1/s): v *= max(0, 1 - c h) each substep, applied before gravity so a body
   /// at rest still weighs m g (validation.md P4).
