@@ -105,8 +105,10 @@ HandActionsInput::HandActionsInput(std::vector<HandAction> actions, float finger
 
 HandFrame HandActionsInput::frame(std::uint64_t, double t) {
   // The action under way, else the next one (its fingertips wait parked above it), else the last.
-  const auto next = std::find_if(actions_.begin(), actions_.end(), [t](const HandAction& a) { return t < a.end(); });
-  const std::size_t i = next == actions_.end() ? actions_.size() - 1 : std::size_t(next - actions_.begin());
+  // The actions end in order, so the search goes on from the last answer while time runs forward.
+  if (next_ > 0 && t < actions_[next_ - 1].end()) next_ = 0;
+  while (next_ < actions_.size() && !(t < actions_[next_].end())) ++next_;
+  const std::size_t i = std::min(next_, actions_.size() - 1);
   HandAction& a = actions_[i];
   if (!(t >= a.start && t < a.end())) return parked(a.target);
   if (aim_ && !aimed_[i]) {

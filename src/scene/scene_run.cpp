@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/os.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -208,13 +209,6 @@ struct PokeTrace {
   }
 };
 
-// The poke under way at time t, if any.
-const HandAction* pokeAt(const std::vector<HandAction>& actions, double t) {
-  for (const HandAction& a : actions)
-    if (a.kind == ActionKind::Poke && t >= a.start && t < a.end()) return &a;
-  return nullptr;
-}
-
 }  // namespace
 
 RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
@@ -234,9 +228,13 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
   std::array<double, kStageCount> residualRmsSum{};
   std::array<std::size_t, kStageCount> residualSteps{};
   double iterations = 0.0;
+  // The scripted pokes by start (they do not overlap); those before firstOpen are done.
   std::vector<PokeTrace> pokes;
   for (const HandAction& a : scene.actions)
     if (a.kind == ActionKind::Poke) pokes.push_back(PokeTrace{&a, {}, {}, {}});
+  std::stable_sort(pokes.begin(), pokes.end(),
+                   [](const PokeTrace& a, const PokeTrace& b) { return a.poke->start < b.poke->start; });
+  std::size_t firstOpen = 0;
   constexpr std::size_t kEventsListed = 100;  // in summary.events; nanEvents counts them all
 
   HandInput* input = settings.input ? settings.input : scene.input.get();
@@ -283,21 +281,28 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
           summary.forceMax[f] = std::max(summary.forceMax[f], h.fingers[f].force);
           summary.newtonsMax[f] = std::max(summary.newtonsMax[f], h.fingers[f].newtons);
         }
-        // Indentation only for the scene's own pokes (a glove's hand has no target).
-        const bool scripted = input == scene.input.get();
-        traces.add(t, h, session->rig(), scripted ? pokeAt(scene.actions, double(k) * summary.dt) : nullptr);
-        if (scripted)
-          for (PokeTrace& p : pokes) {
+        // Indentation only for the scene's own pokes (a glove's hand has no target). Step k
+        // began at k dt, the hand's time for it.
+        const double began = double(k) * summary.dt;
+        const HandAction* poking = nullptr;
+        if (input == scene.input.get())
+          for (std::size_t j = firstOpen; j < pokes.size() && pokes[j].poke->start <= began; ++j) {
+            PokeTrace& p = pokes[j];
             if (p.done) continue;
-            p.add(double(k) * summary.dt, h, session->rig());
-            if (p.complete(summary.dt)) {
-              summary.pokes.push_back(p.signal());
+            if (began < p.poke->end()) poking = p.poke;
+            p.add(began, h, session->rig());
+            if (p.complete(summary.dt) || began >= p.poke->end() + kPokeTail) {
+              if (p.complete(summary.dt)) summary.pokes.push_back(p.signal());
               p = PokeTrace{p.poke, {}, {}, {}, 0, 0, true};
             }
           }
+        while (firstOpen < pokes.size() && pokes[firstOpen].done) ++firstOpen;
+        traces.add(t, h, session->rig(), poking);
       }
       if (files) files->step(scene, session ? &*session : nullptr, times, k, t, contact);
-      if (settings.afterStep && !settings.afterStep(RunStep{k, t, session ? &*session : nullptr, &times, loss})) break;
+      if (settings.afterStep &&
+          !settings.afterStep(RunStep{k, t, session ? &*session : nullptr, &times, loss, summary.nanEvents}))
+        break;
     }
     summary.ok = true;
   } catch (const std::exception& e) {

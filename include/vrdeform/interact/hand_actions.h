@@ -57,6 +57,7 @@ class HandActionsInput final : public HandInput {
   std::vector<HandAction> actions_;  // sorted by start
   std::vector<std::size_t> given_;   // each one's index among those given
   std::vector<bool> aimed_;
+  std::size_t next_ = 0;  // the first action not ended at the last frame's time
   float radius_;
   Aim aim_;
 };

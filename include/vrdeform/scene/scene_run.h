@@ -26,6 +26,7 @@ struct RunStep {
   const HapticSession* session = nullptr;  ///< null in a scene without a hand
   const StageTimes* times = nullptr;       ///< this step's, per stage
   double volumeLoss = 0.0;                 ///< largest over the soft bodies, this step
+  std::uint64_t nanEvents = 0;             ///< so far (RunSummary::nanEvents)
 };
 
 struct RunSettings {
