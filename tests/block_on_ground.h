@@ -1,6 +1,6 @@
 #pragma once
 // A soft cube resting on the ground, its weight carried by the ground contacts: the scene of
-// validation.md V12, shared by the contact tests.
+// docs/validation.md V12, shared by the contact tests.
 
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/world.h"

@@ -183,7 +183,7 @@ using testing::BlockOnGround;
 TEST(Contact, GroundReactionEqualsWeightAtRest) {
   BlockOnGround block;
   for (int step = 0; step < 240; ++step) block.world.step();
-  // Momentum balance at rest (validation.md V12a): sum lambda/h^2 = M g, to 1e-3.
+  // Momentum balance at rest (docs/validation.md V12a): sum lambda/h^2 = M g, to 1e-3.
   EXPECT_NEAR(block.groundReaction(), block.weight, 1e-3f * block.weight);
   // The per-particle readout says the same: net constraint force = weight, upward.
   Vec3 total = Vec3::Zero();
@@ -197,7 +197,7 @@ TEST(Contact, GroundReactionEqualsWeightAtRest) {
 }
 
 TEST(Contact, FingertipPushBalancesGroundReaction) {
-  // validation.md V12a: a kinematic sphere pressed into a block on the ground; at rest the
+  // docs/validation.md V12a: a kinematic sphere pressed into a block on the ground; at rest the
   // fingertip force equals the ground reaction minus the weight, to 1e-3, whether it touches the
   // particles (eqs. 36-39) or the surface triangles.
   for (FingertipContactMode mode : {FingertipContactMode::Particles, FingertipContactMode::Triangles}) {
@@ -219,7 +219,7 @@ TEST(Contact, FingertipPushBalancesGroundReaction) {
 }
 
 TEST(Contact, FingertipForceDoesNotDependOnTheSubstep) {
-  // validation.md V12c: lambda scales as h^2, so lambda/h^2 at rest must not change when the
+  // docs/validation.md V12c: lambda scales as h^2, so lambda/h^2 at rest must not change when the
   // substep is halved (to 1%), with lambda read from the last substep (P9). This holds once the
   // iterations converge: at h = 1/60 with 20 iterations the rest state itself still depends on h
   // (2.7 vs 3.7 N), so the check runs at h = 1/120 and 1/240 with 50 iterations. The fingertip

@@ -1,6 +1,6 @@
 // Fingertips against a body's surface triangles (FingertipContactMode::Triangles, beyond the
 // paper's particle contacts of eqs. 36-39): the projection itself, a fingertip pressing between
-// the vertices of a coarse mesh, the momentum balance of validation.md V12a, disabling, cloth,
+// the vertices of a coarse mesh, the momentum balance of docs/validation.md V12a, disabling, cloth,
 // and bad surface indices.
 
 #include <gtest/gtest.h>

@@ -1,11 +1,11 @@
-// validation.md V3 (hanging chain: support force, stretch, substeps versus iterations) and V9
+// docs/validation.md V3 (hanging chain: support force, stretch, substeps versus iterations) and V9
 // (energy behaviour and the budget experiment on a chain, a cloth and a beam).
 //
-// Float32 note (validation.md P7): at rest each substep predicts a drop h^2 g that is rounded to
+// Float32 note (docs/validation.md P7): at rest each substep predicts a drop h^2 g that is rounded to
 // the float grid of the particle's coordinate, and each Gauss-Seidel update rounds again. A static
 // force read from lambda/h^2 is therefore resolved to about ulp(|y|)/(h^2 g) of each particle's
 // weight, and anything proportional to the weights (a static stretch) to the same relative amount.
-// Where that bound exceeds validation.md's tolerance the tests use a small multiple of it, computed
+// Where that bound exceeds docs/validation.md's tolerance the tests use a small multiple of it, computed
 // from the actual coordinates and h. Coordinates are kept near the origin (anchor at the origin).
 
 #include <gtest/gtest.h>
@@ -104,7 +104,7 @@ struct Hanging {
 };
 
 // Hangs the chain straight down from the origin and lets it settle (damping applied before
-// gravity, so no static bias, validation.md P4).
+// gravity, so no static bias, docs/validation.md P4).
 Hanging hangChain(float link, float compliance, int substeps, int iterations, float timeStep = 1.0f / 60.0f,
                   double seconds = 10.0) {
   World w(settings(substeps, iterations, kSettleDamping, timeStep));
@@ -129,7 +129,7 @@ struct Split {
 // -sum grad C lambda. Summed over the 19 hanging particles the internal links cancel (equal and
 // opposite gradients, no relaxation weights), leaving lambda_0 = -19 m g h^2: the anchor link
 // carries the total hanging mass 19 kg, 190 N (SS19's true value). This is momentum balance, so
-// it holds at any convergence: within 1e-4 (validation.md V3), for compliant and inextensible
+// it holds at any convergence: within 1e-4 (docs/validation.md V3), for compliant and inextensible
 // links and any split, or twice the float bound mean_i ulp(y_i)/(h^2 g) where that is larger
 // (h = 1/1200 s: ~1e-3 for a chain reaching y = -0.2 m; h = 1/60 s: ~1e-5).
 TEST(Chain, SupportForceEqualsHangingWeight) {
@@ -145,7 +145,7 @@ TEST(Chain, SupportForceEqualsHangingWeight) {
 
 // (b) Stretch with compliance alpha = 1e-4 per link: link k (from the bottom) carries k m g, so
 // the total extension is alpha m g sum_{k=1}^{19} k = alpha m g 19*20/2 = 0.19 m. Within 1%
-// (validation.md V3) once the budget is >= 20 substeps or >= 20 iterations.
+// (docs/validation.md V3) once the budget is >= 20 substeps or >= 20 iterations.
 TEST(Chain, CompliantStretch) {
   constexpr float alpha = 1e-4f;
   const double expected = double(alpha) * 1.0 * kG * kHanging * (kHanging + 1) / 2.0;
@@ -160,7 +160,7 @@ TEST(Chain, CompliantStretch) {
 // from v = 0, so the Gauss-Seidel sweep maps the link stretches linearly plus a term h^2 g; the
 // steady residual stretch solves a linear system whose right-hand side is h^2 g, so it is
 // exactly proportional to h^2 (and independent of the link length). Going from 20 to 100
-// substeps must cut it at least 25-fold (validation.md V3); by the same argument the ratio is
+// substeps must cut it at least 25-fold (docs/validation.md V3); by the same argument the ratio is
 // exactly 25, so it is checked from both sides. The time step is 1/6 s, so h = 1/120 and
 // 1/600 s: the steady state depends on h alone, and h^2 g stays far above the float grid
 // (tolerance: twice the worst particle's ulp(|y|)/(h^2 g) at the finer h, ~0.9%).
@@ -248,7 +248,7 @@ struct Scene {
 };
 
 // Stretch: after 4 s with damping (settled well within the margins between the splits). Energy
-// loss: E(0) - E(2 s) without damping, from the released start. Required (validation.md V9):
+// loss: E(0) - E(2 s) without damping, from the released start. Required (docs/validation.md V9):
 // both strictly increase along (B, 1), (B/4, 4), (1, B), and the undamped energy never exceeds
 // its start by more than the accumulated rounding bound.
 void budgetExperiment(const Scene& scene) {

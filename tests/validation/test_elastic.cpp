@@ -1,4 +1,4 @@
-// V5 (validation.md): the E, nu -> compliance mapping of makeSoftBody under prescribed uniaxial
+// V5 (docs/validation.md): the E, nu -> compliance mapping of makeSoftBody under prescribed uniaxial
 // strain. A box of tets is stretched by eps = 1e-3 along y between rollers and its reaction force
 // and lateral contraction are compared with linear elasticity.
 //

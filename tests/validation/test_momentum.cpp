@@ -1,4 +1,4 @@
-// V8 (validation.md): momentum of a free-floating soft body (g = 0, no contacts) with all internal
+// V8 (docs/validation.md): momentum of a free-floating soft body (g = 0, no contacts) with all internal
 // constraints active. Every XPBD correction is dp_i = w_i grad_i C dlambda and the constraint
 // functions are translation and rotation invariant, so sum_i m_i dp_i = 0 and
 // sum_i m_i p_i x dp_i = 0 for each projection (RB20 section 3.3): internal constraints do not

@@ -1,4 +1,4 @@
-// V11 (validation.md): robustness against degenerate, inverted and sliver elements.
+// V11 (docs/validation.md): robustness against degenerate, inverted and sliver elements.
 //
 // (a) A 0.1 m cube (4x4x4 cells, 384 tets; E = 10 kPa, nu = 0.3, rho = 1000; the paper's volume +
 //     strain + shape-matching set) is flattened onto a plane (every J = 0) or has half of its

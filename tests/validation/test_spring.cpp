@@ -1,10 +1,10 @@
-// validation.md V1 (single compliant spring: period, damping, iteration independence) and V2
+// docs/validation.md V1 (single compliant spring: period, damping, iteration independence) and V2
 // (static elongation and force readout lambda/h^2, single spring and 1 g / 1 kg mass ratio).
 //
-// Float32 note (validation.md P7): positions are float. At rest the predicted displacement h^2 g is
+// Float32 note (docs/validation.md P7): positions are float. At rest the predicted displacement h^2 g is
 // rounded to the float grid of the coordinate, and the solver rounds each position update, so a
 // static force lambda/h^2 (and with it a static stretch alpha f) is resolved only to about
-// ulp(|y|)/(h^2 g) relative (two half-ulp roundings). Where that exceeds validation.md's tolerance
+// ulp(|y|)/(h^2 g) relative (two half-ulp roundings). Where that exceeds docs/validation.md's tolerance
 // the test uses a small multiple of the bound, computed from the actual coordinates and h.
 
 #include <gtest/gtest.h>
@@ -37,7 +37,7 @@ constexpr float kSpringCompliance = 1e-3f;
 constexpr double kA0 = 0.5;                                        // initial displacement x0 - rest (m)
 const double kOmega = 1.0 / std::sqrt(double(kSpringCompliance));  // sqrt(k/m) = 31.62 rad/s
 const double kPeriod = 2.0 * kPi / kOmega;                         // 0.19869 s
-constexpr double kFloatTol = 1e-4;                                 // validation.md V1: float trajectories
+constexpr double kFloatTol = 1e-4;                                 // docs/validation.md V1: float trajectories
 
 struct Trajectory {
   double dt = 0;  // sampling interval = time step (s)
@@ -115,7 +115,7 @@ double measuredPeriod(const Trajectory& tr, double tEnd) {
 
 // (a) In 1-D the constraint is linear, so the first Gauss-Seidel update with the accumulated
 // lambda solves each substep exactly and further iterations change nothing: 1, 10 and 100
-// iterations give the same trajectory to float precision (1e-4 relative, validation.md V1).
+// iterations give the same trajectory to float precision (1e-4 relative, docs/validation.md V1).
 TEST(Spring, TrajectoryIndependentOfIterations) {
   for (int substeps : {1, 10}) {
     const Trajectory base = runSpring(1.0f / 60.0f, substeps, 1, 2.0);
@@ -131,7 +131,7 @@ TEST(Spring, TrajectoryIndependentOfIterations) {
 }
 
 // (b) h = 1/600 s reached two ways (1/60 s x 10 substeps, 1/600 s x 1 substep): the measured
-// period is T wh/atan(wh) = 0.19888 s within 0.1% (validation.md V1), and both runs follow the
+// period is T wh/atan(wh) = 0.19888 s within 0.1% (docs/validation.md V1), and both runs follow the
 // same recurrence, so they agree at common times to float precision.
 TEST(Spring, PeriodMatchesBackwardEuler) {
   const Trajectory sub = runSpring(1.0f / 60.0f, 10, 1, 4.0);
@@ -147,7 +147,7 @@ TEST(Spring, PeriodMatchesBackwardEuler) {
 }
 
 // (c), (d) h = 1/600 s, sampled every substep: every peak of |u| lies within 2% of the
-// backward-Euler envelope A0 (1 + w^2 h^2)^(-t/(2h)) (validation.md V1; the largest sample of a
+// backward-Euler envelope A0 (1 + w^2 h^2)^(-t/(2h)) (docs/validation.md V1; the largest sample of a
 // crest can sit up to one sample, theta, from it since the decay per sample 1 - r equals
 // 1 - cos theta, so sampling costs at most 1.4e-3), successive peaks strictly decrease (they shrink by
 // r^(pi/theta) = 0.92 per half period), and no sample exceeds the envelope by more than float
@@ -190,7 +190,7 @@ TEST(Spring, SmallStepsBeatIterations) {
     }
     // The samples A0 r^n cos(n theta) advance by a phase Theta = substeps * theta per step, so
     // over a window longer than a period one of them is within cos(Theta/2) of the envelope
-    // (less validation.md's 2% amplitude tolerance).
+    // (less docs/validation.md's 2% amplitude tolerance).
     const double phaseStep = tr->substeps * std::atan(kOmega * tr->h);
     const double floor = std::cos(phaseStep / 2) * beEnvelope(tr->h, 2.0);
     EXPECT_GE(tail, 0.98 * floor) << tr->substeps << " substeps";
@@ -201,14 +201,14 @@ TEST(Spring, SmallStepsBeatIterations) {
 // V2: static elongation alpha m g and force lambda/h^2 = m g (RB20 §4). At rest x^n = x^{n-1}, so
 // x~ - x = h^2 g and the converged conditions give lambda = -m g h^2, C = alpha m g for any h.
 // One spring per body is linear in 1-D, so one iteration converges. linearDamping settles the
-// motion; it is applied before gravity, so a body at rest still weighs m g (validation.md P4).
+// motion; it is applied before gravity, so a body at rest still weighs m g (docs/validation.md P4).
 //
 // Coordinates: the anchor sits at y = L above the origin, so the hanging particle rests near
 // y = 0 and its float grid is fine (ulp(0.1) = 7.5e-9 m).
 
 constexpr float kGravity = 10.0f;
 constexpr float kSettleDamping = 20.0f;  // 1/s: critical for 1 kg at k = 100 N/m (2 sqrt(k/m))
-constexpr double kStaticTol = 1e-3;      // validation.md V2
+constexpr double kStaticTol = 1e-3;      // docs/validation.md V2
 
 struct Static {
   std::vector<double> stretch;  // per link, top first (m)

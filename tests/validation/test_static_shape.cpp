@@ -1,4 +1,4 @@
-// XPBD's headline property (XPBD16 section 4; validation.md V2/V3): with alpha~ = alpha/h^2 the
+// XPBD's headline property (XPBD16 section 4; docs/validation.md V2/V3): with alpha~ = alpha/h^2 the
 // converged static solution depends on the material, not on the iteration count. One scene is
 // settled with 5, 20 and 80 Gauss-Seidel iterations per substep and the shapes are compared.
 //

@@ -1,4 +1,4 @@
-// V6 (validation.md): volume conservation with zero-compliance tet volume constraints
+// V6 (docs/validation.md): volume conservation with zero-compliance tet volume constraints
 // (paper section 4.2, C = V - V0 with the signed volume, eqs. 16-23).
 //
 // The body: a 0.1 m cube of 4x4x4 cells (384 tets), strain constraints from E = 10 kPa (a jelly;

@@ -36,7 +36,7 @@ struct SolverSettings {
   int iterations = 5;  ///< Gauss-Seidel iterations per substep; the paper uses 5
   Vec3 gravity{0.0f, -9.81f, 0.0f};
   /// Velocity damping c (1/s): v *= max(0, 1 - c h) each substep, applied before gravity so a body
-  /// at rest still weighs m g (validation.md P4).
+  /// at rest still weighs m g (docs/validation.md P4).
   float linearDamping = 0.0f;
   NanPolicy onNan = NanPolicy::Freeze;
   bool timeStages = true;  ///< record per-stage wall-clock times (a few dozen clock reads per step)
