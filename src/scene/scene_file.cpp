@@ -398,7 +398,11 @@ SolverSettings readSolver(const Table& t) {
   bool simd = true;
   t.readBool("simd", simd);
   s.simd = simd ? SimdLevel::Best : SimdLevel::Off;
-  t.readInt("threads", s.threads, 1, 256);
+  if (std::optional<Field> f = t.get("threads")) {
+    if (f->isString() && f->string() != "auto")
+      f->fail(fmt::format("expected an integer or \"auto\", got '{}'", printable(f->string())));
+    s.threads = f->isString() ? SolverSettings::kAutoThreads : int(f->integer(1, 256));
+  }
   t.readBool("fuse_strain_volume", s.fuseStrainVolume);
   s.measureResiduals = true;  // the scene default: runs and the viewer show how converged each step is
   t.readBool("measure_residuals", s.measureResiduals);

@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <iterator>
+#include <thread>
 
 #include "vrdeform/error.h"
 
@@ -47,10 +49,15 @@ void validateSolverSettings(const SolverSettings& s) {
     throw Error(fmt::format("solver: linear damping must be finite and >= 0, got {}", s.linearDamping));
   if (!(std::isfinite(s.tolerance) && s.tolerance >= 0.0f))
     throw Error(fmt::format("solver: tolerance must be finite and >= 0, got {}", s.tolerance));
-  if (s.threads < 1 || s.threads > 256)
-    throw Error(fmt::format("solver: threads must be in [1, 256], got {}", s.threads));
+  if (s.threads < 0 || s.threads > 256)
+    throw Error(fmt::format("solver: threads must be in [1, 256] or kAutoThreads (0), got {}", s.threads));
   if (std::size_t(s.simd) > std::size_t(SimdLevel::Best)) throw Error("solver: unknown SIMD level");
   if (!cpuSupports(s.simd)) throw Error(fmt::format("solver: this CPU cannot run SIMD level {}", simdName(s.simd)));
+}
+
+int solverThreads(const SolverSettings& s) {
+  if (s.threads != SolverSettings::kAutoThreads) return s.threads;
+  return std::thread::hardware_concurrency() >= 2 ? 2 : 1;
 }
 
 }  // namespace vrd

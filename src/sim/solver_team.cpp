@@ -1,5 +1,7 @@
 #include "solver_team.h"
 
+#include <algorithm>
+
 namespace vrd {
 namespace {
 
@@ -24,6 +26,36 @@ void waitForChange(const std::atomic<std::uint32_t>& value, std::uint32_t old) {
     relax();
   }
   while (value.load(std::memory_order_acquire) == old) value.wait(old, std::memory_order_acquire);
+}
+
+void TeamChoice::record(double seconds) {
+  if (trialLeft_ > 0) {
+    // Ended early once it cannot win: a team on a machine far busier than its cores can be ten
+    // times slower, and a whole trial would cost more than the choice saves.
+    trialSum_ += seconds;
+    --trialLeft_;
+    const bool lost = trialSum_ >= kTrialSteps * kMargin * mean_;
+    if (trialLeft_ > 0 && !lost) return;
+    other_ = trialSum_ / (kTrialSteps - trialLeft_);
+    trialLeft_ = 0;
+    if (other_ < kMargin * mean_) {
+      std::swap(mean_, other_);
+      steps_ = kTrialSteps;
+      team_ = !team_;
+      interval_ = kFirstInterval;
+    } else {
+      interval_ = std::min(2 * interval_, kLongestInterval);  // the choice held: try less often
+    }
+    untilTrial_ = interval_;
+    return;
+  }
+  steps_ = std::min(steps_ + 1, kWindow);
+  mean_ += (seconds - mean_) / steps_;
+  // A trial when one is due, or at once when this way has become slower than the other was.
+  if (--untilTrial_ <= 0 || (other_ > 0.0 && steps_ == kWindow && kMargin * mean_ > other_)) {
+    trialLeft_ = kTrialSteps;
+    trialSum_ = 0.0;
+  }
 }
 
 ThreadTeam::ThreadTeam(int size) : size_(size), barrier_(size) {

@@ -66,6 +66,34 @@ struct SolverTeam {
   }
 };
 
+/// Whether a step runs on the team or on the calling thread alone. On a machine with more runnable
+/// threads than cores, a member the scheduler takes off its core holds every barrier up for a time
+/// slice, and one thread may be faster than two. So the steps' wall times are measured: the way
+/// taken as a running mean (over about kWindow steps, so that occasional long steps count as often
+/// as they come), the other way by a trial of kTrialSteps steps now and then (ended as soon as it
+/// cannot win), less often the longer the choice holds, and at once when the way taken has become
+/// slower than the other was. It starts alone, the safe way. Both ways give the same result, bit
+/// for bit.
+class TeamChoice {
+ public:
+  /// Whether the next step should run on the team.
+  bool useTeam() const { return trialLeft_ > 0 ? !team_ : team_; }
+  /// A step ran as useTeam() said and took `seconds` of wall time.
+  void record(double seconds);
+
+ private:
+  static constexpr int kWindow = 32, kTrialSteps = 16, kFirstInterval = 64, kLongestInterval = 2048;
+  static constexpr double kMargin = 0.9;  // the other way must be this much faster to switch to it
+
+  bool team_ = false;
+  double mean_ = 0.0;   // the way taken: running mean of its step times (s)
+  int steps_ = 0;       // steps in mean_, up to kWindow
+  double other_ = 0.0;  // the other way: mean of its last trial (s); 0 before one
+  int interval_ = kFirstInterval, untilTrial_ = kTrialSteps;
+  int trialLeft_ = 0;  // steps of the trial under way
+  double trialSum_ = 0.0;
+};
+
 /// `size` threads: the caller of run() and size - 1 workers that live as long as the team and
 /// sleep between runs.
 class ThreadTeam {
@@ -76,6 +104,8 @@ class ThreadTeam {
   ThreadTeam& operator=(const ThreadTeam&) = delete;
 
   int size() const { return size_; }
+  /// Whether the team pays on this machine now: the caller asks and reports back.
+  TeamChoice& choice() { return choice_; }
 
   /// Runs job(member) on every member, the caller being the leader (index 0), and returns when all
   /// have finished. `job` must not throw.
@@ -90,6 +120,7 @@ class ThreadTeam {
   void work(int index);
 
   int size_;
+  TeamChoice choice_;
   TeamBarrier barrier_;
   std::atomic<std::uint32_t> runs_{0};  // bumped to start a run; workers wait for it to change
   bool stopping_ = false;               // read by workers after a change of runs_

@@ -295,12 +295,22 @@ void World::step() {
   const bool cut = std::any_of(bodies_.begin(), bodies_.end(), [](const Body& b) {
     return b.state == BodyState::Active && !(b.model->tetGroups.empty() && b.model->distanceGroups.empty());
   });
-  if (settings_.threads > 1 && cut) {
+  const int threads = solverThreads(settings_);
+  if (threads > 1 && cut) {
     std::unique_ptr<ThreadTeam>& team = team_.team;
-    if (!team || team->size() != settings_.threads) team = std::make_unique<ThreadTeam>(settings_.threads);
-    memberContacts_.resize(std::size_t(settings_.threads));
-    memberFinite_.resize(std::size_t(settings_.threads) * bodies_.size());
-    team->run([this](const SolverTeam& member) { substeps(member); });
+    if (!team || team->size() != threads) team = std::make_unique<ThreadTeam>(threads);
+    const bool onTeam = !settings_.threadsFallBack || team->choice().useTeam();
+    const auto start = std::chrono::steady_clock::now();
+    if (onTeam) {
+      memberContacts_.resize(std::size_t(threads));
+      memberFinite_.resize(std::size_t(threads) * bodies_.size());
+      team->run([this](const SolverTeam& member) { substeps(member); });
+    } else {
+      memberFinite_.resize(bodies_.size());
+      substeps(SolverTeam{});
+    }
+    if (settings_.threadsFallBack)
+      team->choice().record(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   } else {
     memberFinite_.resize(bodies_.size());
     substeps(SolverTeam{});

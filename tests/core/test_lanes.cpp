@@ -8,6 +8,7 @@
 #include <random>
 
 #include "sim/lane_sweeps.h"
+#include "sim/solver_team.h"
 #include "vrdeform/error.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/constraint_colouring.h"
@@ -442,7 +443,9 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactly) {
   ASSERT_EQ(big->tetGroups.size(), 6u);
   for (const auto& models : {std::vector{small}, std::vector{big}, std::vector{big, small}}) {
     SolverSettings s;
+    s.threads = 1;
     const std::vector<Vec3> one = sagBlocks(models, s, 5);
+    s.threadsFallBack = false;  // the team every step, however busy the machine
     for (int threads : {2, 3}) {
       s.threads = threads;  // (on a busy machine a barrier may wait for a descheduled thread: few steps)
       const std::vector<Vec3> many = sagBlocks(models, s, 5);
@@ -450,6 +453,69 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactly) {
         ASSERT_EQ(many[i], one[i]) << models.size() << " bodies, " << threads << " threads, particle " << i;
     }
   }
+}
+
+// A world whose steps go to the team or to one thread as TeamChoice decides (here: as its
+// settings say, step by step) still gives the one-thread result bit for bit.
+TEST(Lanes, SwitchingBetweenTheTeamAndOneThreadKeepsTheResult) {
+  const auto big = dampedBlock(10, {true, true, true, true});
+  ASSERT_FALSE(big->tetGroups.empty());
+  SolverSettings s;
+  s.threads = 1;
+  World one(s), switching(s);
+  for (World* w : {&one, &switching}) {
+    const BodyId b = w->addBody(big);
+    for (Index i = 0; i < big->particleCount(); ++i)
+      if (big->restPositions[i].x() < -0.0499f) w->setInverseMass(w->particleIndex(b, i), 0.0f);
+  }
+  s.threadsFallBack = false;
+  for (int step = 0; step < 8; ++step) {
+    s.threads = step % 3 == 2 ? 1 : 2;
+    switching.setSettings(s);
+    one.step();
+    switching.step();
+  }
+  for (std::size_t i = 0; i < one.particles().x.size(); ++i)
+    ASSERT_EQ(switching.particles().x[i].pos, one.particles().x[i].pos) << "particle " << i;
+}
+
+// TeamChoice with made-up step times: the faster way nearly always, the other tried for up to 16
+// steps at growing intervals (64 steps, doubling up to 2,048), and back soon when the load changes.
+int teamSteps(TeamChoice& choice, int steps, double team, double alone) {
+  int onTeam = 0;
+  for (int k = 0; k < steps; ++k) {
+    const bool t = choice.useTeam();
+    onTeam += t ? 1 : 0;
+    choice.record(t ? team : alone);
+  }
+  return onTeam;
+}
+
+TEST(TeamChoice, TakesTheFasterWayAndTriesTheOtherSeldom) {
+  TeamChoice idle, busy;
+  for (const int other : {10'000 - teamSteps(idle, 10'000, 0.5e-3, 1e-3), teamSteps(busy, 10'000, 3e-3, 1e-3)}) {
+    EXPECT_GE(other, 1 + 10'000 / (2'048 + 16));  // a trial at least every 2,048 steps
+    EXPECT_LE(other, 200);                        // 2% of the steps
+  }
+}
+
+TEST(TeamChoice, FollowsTheMachinesLoad) {
+  TeamChoice c;
+  EXPECT_LT(teamSteps(c, 5'000, 3e-3, 1e-3), 150);  // busy: alone, 3% of the steps trials
+  // Idle again: the next trial of the team, at most 2,048 steps on, switches back.
+  EXPECT_GT(teamSteps(c, 3'000, 0.5e-3, 1e-3), 3'000 - 2'048 - 16);
+  EXPECT_TRUE(c.useTeam());
+  // Occasional long team steps (a member off its core) count as often as they come: one in ten
+  // at 8 ms makes the team slower on average (1.25 ms) than one thread (1 ms), which it soon
+  // finds out without waiting for its next trial.
+  int onTeam = 0;
+  for (int k = 0; k < 200; ++k) {
+    const bool t = c.useTeam();
+    onTeam += t ? 1 : 0;
+    c.record(t ? (k % 10 == 9 ? 8e-3 : 0.5e-3) : 1e-3);
+  }
+  EXPECT_LT(onTeam, 100);
+  EXPECT_FALSE(c.useTeam());
 }
 
 // The world's constraints under a team: collider and fingertip contacts shared at a particle
@@ -463,6 +529,7 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactlyWithContacts) {
   const auto run = [&](int threads, std::size_t& contacts) {
     SolverSettings s;
     s.threads = threads;
+    s.threadsFallBack = false;
     s.substeps = 2;  // the team predicts, detects and finalises again between substeps
     World w(s);
     const BodyId b = w.addBody(model, Vec3(0.0f, 0.002f, 0.0f));
@@ -507,6 +574,7 @@ TEST(Lanes, ThreadsContainANonFiniteBodyAsOneThreadDoes) {
   const auto run = [&](int threads) {
     SolverSettings s;
     s.threads = threads;
+    s.threadsFallBack = false;
     s.substeps = 2;
     World w(s);
     w.addBody(block, Vec3(0.0f, 0.5f, 0.0f));

@@ -56,6 +56,7 @@ TEST(Residuals, AreNotMeasuredUnlessAskedAndDoNotChangeTheResult) {
     BlockOnGround plain, measuring;
     SolverSettings s = plain.world.settings();
     s.threads = threads;
+    s.threadsFallBack = false;
     plain.world.setSettings(s);
     s.measureResiduals = true;
     measuring.world.setSettings(s);

@@ -360,7 +360,7 @@ TEST(SceneFile, AbsentKeysKeepTheirDefaults) {
   EXPECT_EQ(s.solver.iterations, d.solver.iterations);
   EXPECT_EQ(s.solver.gravity, d.solver.gravity);
   EXPECT_EQ(s.solver.simd, SimdLevel::Best);
-  EXPECT_EQ(s.solver.threads, 1);
+  EXPECT_EQ(s.solver.threads, SolverSettings::kAutoThreads);
   EXPECT_TRUE(s.solver.fuseStrainVolume);
   EXPECT_TRUE(s.solver.measureResiduals);  // the scenes' default, unlike SolverSettings'
   EXPECT_EQ(s.solver.tolerance, 0.0f);
@@ -429,6 +429,14 @@ TEST(SceneFile, MaxChangeMayBeInfinite) {
   EXPECT_EQ(parse(std::string(kMinimal) + "[haptics]\nmax_change_per_ms = inf\n").haptics.settings.maxChangePerMs, inf);
   EXPECT_EQ(errorIn(std::string(kMinimal) + "[haptics]\nmax_change_per_ms = \"fast\"\n"),
             "scene.toml:4: haptics.max_change_per_ms: expected a number or \"inf\", got 'fast'");
+}
+
+TEST(SceneFile, ThreadsMayBeAuto) {
+  EXPECT_EQ(parse(std::string(kMinimal) + "[solver]\nthreads = \"auto\"\n").solver.threads,
+            SolverSettings::kAutoThreads);
+  EXPECT_EQ(errorIn(std::string(kMinimal) + "[solver]\nthreads = \"many\"\n"),
+            "scene.toml:4: solver.threads: expected an integer or \"auto\", got 'many'");
+  EXPECT_NE(errorIn(std::string(kMinimal) + "[solver]\nthreads = 0\n").find("solver.threads"), std::string::npos);
 }
 
 TEST(SceneFile, GraspOffDisablesGrasping) {

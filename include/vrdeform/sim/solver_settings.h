@@ -45,7 +45,13 @@ struct SolverSettings {
   /// Solver threads (src/sim/solver_team.h): 2 sweep the halves of a big body at once, more share each colour;
   /// the result does not depend on it. Worth it for bodies of several thousand tets: a world with
   /// no body of 4,096 or more constraints of one type runs on the calling thread alone, as does 1.
-  int threads = 1;
+  /// kAutoThreads: two where the machine has two hardware threads or more (solverThreads()).
+  int threads = kAutoThreads;
+  static constexpr int kAutoThreads = 0;
+  /// With more than one thread, a step runs on the calling thread alone while that has lately been
+  /// faster than the team (a machine busier than its cores; the result is the same). false: always
+  /// the team.
+  bool threadsFallBack = true;
   /// Projects a tet's strain and volume constraints together, in one pass over the tets
   /// (strain_volume.h), instead of all strain constraints and then all volume ones as the paper
   /// does. Both are Gauss-Seidel orders with the same fixed points; the pass reads and writes each
@@ -67,5 +73,8 @@ struct SolverSettings {
 /// Throws vrd::Error for a non-positive or non-finite time step, substeps or iterations < 1,
 /// non-finite gravity, negative damping, threads outside [1, 256] or SIMD this CPU lacks.
 void validateSolverSettings(const SolverSettings& settings);
+
+/// The threads a world with these settings solves with: `threads`, kAutoThreads resolved.
+int solverThreads(const SolverSettings& settings);
 
 }  // namespace vrd
