@@ -7,9 +7,6 @@
 //    issue 6's target of 0.1 ms per step on one core; the paper measured 8.8-19.3 ms for it.
 //  - Cube/...: issue 6's 105,456-tet cube on the ground (edges + volume), 1 x 5 and 5 x 1, 1 and 2
 //    threads, against its target of 2.5 ms per step on 2 cores.
-//  - Contended/...: the 10k-tet block (paper set, 5 iterations) and the 105k cube (5 x 1) beside
-//    `neighbours` threads that spin as other programs would, on one thread, on two always (the
-//    team every step) and on two with the fallback to one (the default): mean and P90 per step.
 //  - StrainKernel/...: the closed-form strain projection against the straightforward one.
 // With --benchmark_repetitions, PaperBody and Cube also report the least time of the repetitions.
 // Counters: tet_constraints/s counts each volume, strain (all six components) and edge constraint
@@ -18,10 +15,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <random>
-#include <thread>
 
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/world.h"
@@ -49,6 +43,7 @@ void runSteps(benchmark::State& state, const TetMesh& mesh, const ConstraintSet&
   settings.simd = simd;
   settings.fuseStrainVolume = simd != SimdLevel::Off;  // the baseline: the paper's algorithm as it stands
   settings.threads = threads;
+  settings.threadsFallBack = false;  // threads:2 times the team
   settings.timeStages = false;
   World world(settings);
   const auto model = makeSoftBody(mesh, benchMaterial(), set);
@@ -98,6 +93,7 @@ void Cube(benchmark::State& state) {
   settings.substeps = int(state.range(0));
   settings.iterations = 5 / settings.substeps;
   settings.threads = int(state.range(1));
+  settings.threadsFallBack = false;
   settings.timeStages = false;
   Material stiff;
   stiff.elastic = ElasticModuli{1e7f, 0.3f, 1000.0f, 0.0f};
@@ -115,57 +111,6 @@ BENCHMARK(Cube)
     ->ArgsProduct({{1, 5}, {1, 2}})
     ->Iterations(60)
     ->ComputeStatistics("min", least)
-    ->Unit(benchmark::kMillisecond);
-
-// Threads beside other work: a VR machine also runs a compositor, a browser or a renderer. threads:
-// 1; 2 = the team every step (threadsFallBack off); 3 = two with the fallback to one (the default).
-void Contended(benchmark::State& state) {
-  const bool cube = state.range(0) != 0;
-  SolverSettings settings;
-  settings.threads = state.range(1) == 1 ? 1 : 2;
-  settings.threadsFallBack = state.range(1) == 3;
-  settings.timeStages = false;
-  Material stiff;
-  stiff.elastic = ElasticModuli{1e7f, 0.3f, 1000.0f, 0.0f};
-  if (cube) settings.substeps = 5, settings.iterations = 1;
-  const auto model = cube ? makeSoftBody(makeBoxTets(Vec3(-0.5f, 0.0f, -0.5f), Vec3::Ones(), 26, 26, 26), stiff,
-                                         ConstraintSet::edgesAndVolume())
-                          : makeSoftBody(block(10000), benchMaterial(), ConstraintSet::paper());
-  World world(settings);
-  const BodyId body = world.addBody(model);
-  if (cube)
-    world.addCollider(Collider::plane(Vec3::UnitY()));
-  else
-    for (Index i = 0; i < model->particleCount(); ++i)
-      if (model->restPositions[i].z() < 1e-6f) world.setInverseMass(world.particleIndex(body, i), 0.0f);
-  std::atomic<bool> stop{false};
-  std::vector<std::thread> neighbours;
-  for (int k = 0; k < state.range(2); ++k)
-    neighbours.emplace_back([&stop] {
-      volatile double x = 1.0;
-      while (!stop.load(std::memory_order_relaxed)) x = x * 1.0000001 + 1e-9;
-    });
-  for (int s = 0; s < 5; ++s) world.step();
-  std::vector<double> ms;
-  for (auto _ : state) {
-    const auto start = std::chrono::steady_clock::now();
-    world.step();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-  }
-  stop = true;
-  for (std::thread& t : neighbours) t.join();
-  std::sort(ms.begin(), ms.end());
-  double sum = 0.0;
-  for (double v : ms) sum += v;
-  state.counters["mean_ms"] = sum / double(ms.size());
-  state.counters["p90_ms"] = ms[ms.size() * 9 / 10];
-  state.counters["tets"] = double(model->tets.size());
-  state.SetLabel(state.range(1) == 1 ? "1 thread" : state.range(1) == 2 ? "2 threads, always" : "2 threads, fallback");
-}
-BENCHMARK(Contended)
-    ->ArgNames({"cube", "threads", "neighbours"})
-    ->ArgsProduct({{0, 1}, {1, 2, 3}, {0, 1, 2}})
-    ->Iterations(1000)
     ->Unit(benchmark::kMillisecond);
 
 void StrainKernel(benchmark::State& state) {
