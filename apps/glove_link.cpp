@@ -4,6 +4,8 @@
 
 #include <thread>
 
+#include "vrdeform/error.h"
+
 namespace vrd {
 namespace {
 
@@ -24,6 +26,15 @@ Eigen::Isometry3f wristAbove(const Vec3& point, const HandGeometry& hand) {
   const Vec3 reach = fingertipPosition(hand, pose, Finger::Index);  // wrist at the origin
   pose.wrist.translation() = point + Vec3(0.0f, 0.5f * hand.fingertipRadius, 0.0f) - reach;
   return pose.wrist;
+}
+
+std::string weartEndpointError(const std::string& endpoint) {
+  try {
+    weart::parseEndpoint(endpoint);
+    return "";
+  } catch (const Error& e) {
+    return e.what();
+  }
 }
 
 GloveLink::GloveLink(const std::string& endpoint, const HandRigSettings& hand, const Vec3& point)

@@ -16,6 +16,10 @@
 
 namespace vrd {
 
+/// For a command's --weart option (a CLI11 validator): "" for an endpoint weart::parseEndpoint takes,
+/// else why not, so that a malformed one is refused at once instead of retried.
+std::string weartEndpointError(const std::string& endpoint);
+
 class GloveLink {
  public:
   /// Connects in the background to `endpoint` (HOST[:PORT]) with a thimble per finger of `hand`;

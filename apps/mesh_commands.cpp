@@ -43,6 +43,8 @@ struct TetArgs {
 };
 
 int tetrahedraliseCommand(const TetArgs& a) {
+  if (!a.output.empty()) checkTetMeshOutput(a.output);
+  if (!a.surfaceOutput.empty()) checkSurfaceOutput(a.surfaceOutput);
   const TriMesh surface = readSurface(a.input);
   TetrahedraliseOptions options;
   options.mesher = a.mesher == "tetgen" ? Mesher::TetGen : Mesher::Builtin;

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "scene_video.h"
+#include "vrdeform/core/write_file.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
 #include "vrdeform/scene/scene_library.h"
@@ -22,6 +23,7 @@ struct RenderArgs {
 };
 
 int render(const RenderArgs& a) {
+  prepareOutputFolder(a.out);
   const SceneSpec spec = loadSceneByName(a.scene);
   fmt::print("scene {}: {}\n", spec.name, spec.description);
   BuiltScene scene = buildScene(spec, [](std::string_view line) { fmt::print("{}\n", line); });

@@ -11,6 +11,7 @@
 
 #include "glove_link.h"
 #include "scene_video.h"
+#include "vrdeform/core/write_file.h"
 #include "vrdeform/devices/csv_recorder.h"
 #include "vrdeform/devices/osc_output.h"
 #include "vrdeform/devices/stop_signals.h"
@@ -165,6 +166,7 @@ class Progress {
 
 int run(const RunArgs& a) {
   if (a.render && a.out.empty()) throw Error("--render needs --out DIR for the frames");
+  if (!a.out.empty()) prepareOutputFolder(a.out);
   SceneSpec spec = loadSceneByName(a.scene);
   if (a.substeps > 0) spec.solver.substeps = a.substeps;
   if (a.iterations > 0) spec.solver.iterations = a.iterations;
@@ -271,7 +273,8 @@ std::function<int()> addRunCommands(CLI::App& app) {
       ->capture_default_str();
   run->add_option("--weart", a->weart,
                   "Drive the hand from a WEART glove and send it the forces, in real time: HOST[:PORT] of the "
-                  "middleware (default port 13031)");
+                  "middleware (default port 13031)")
+      ->check(CLI::Validator(weartEndpointError, "HOST[:PORT]"));
   run->add_option("--forces", a->forces, "Log every step's per-finger forces with timestamps to this CSV file");
   run->add_option("--osc", a->osc, "Send every step's forces as OSC over UDP to HOST:PORT (docs/outputs.md)");
   run->add_flag("--render", a->render,

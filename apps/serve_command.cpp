@@ -144,9 +144,11 @@ std::function<int()> addServeCommand(CLI::App& app) {
       ->capture_default_str();
   serve->add_option("--seconds", a->seconds, "Stop after this many seconds (default: at Ctrl-C)")
       ->check(CLI::Range(0.0, 1e9));
-  serve->add_option("--weart", a->weart,
-                    "Send the forces to a WEART glove and close the hand with it: HOST[:PORT] of the middleware "
-                    "(default port 13031); without a glove the controllers vibrate with the force");
+  serve
+      ->add_option("--weart", a->weart,
+                   "Send the forces to a WEART glove and close the hand with it: HOST[:PORT] of the middleware "
+                   "(default port 13031); without a glove the controllers vibrate with the force")
+      ->check(CLI::Validator(weartEndpointError, "HOST[:PORT]"));
   return [a, serve]() -> int {
     if (*serve) return vrd::serve(*a);
     return 0;

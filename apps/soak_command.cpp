@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "vrdeform/core/write_file.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
 #include "vrdeform/metrics/sample_stats.h"
@@ -56,6 +57,7 @@ void repeatActions(HandSpec& hand, double cycle, double seconds) {
 }
 
 int soak(const SoakArgs& a) {
+  if (!a.out.empty()) prepareOutputFolder(a.out);
   SceneSpec spec = loadSceneByName(a.scene);
   if (!spec.hand.enabled || !spec.hand.script.empty() || spec.hand.actions.empty())
     throw Error(fmt::format("soak: scene {} has no scripted hand actions ([[hand.action]]) to repeat", spec.name));

@@ -643,7 +643,8 @@ std::function<int()> addTouchCommand(CLI::App& app) {
   cmd->add_option("--osc", args->osc, "Send every step's forces as OSC over UDP to HOST:PORT (docs/outputs.md)");
   cmd->add_option("--weart", args->weart,
                   "Drive the hand from a WEART glove and send it the forces: the middleware's HOST:PORT "
-                  "(default port 13031)");
+                  "(default port 13031)")
+      ->check(CLI::Validator(weartEndpointError, "HOST[:PORT]"));
   cmd->add_option("--record", args->record, "Save the session (settings, hand and outputs per step)");
   cmd->add_option("--replay", args->replay,
                   "Rebuild the scene of a recording, replay its hand and check the outputs bit for bit");

@@ -2,6 +2,7 @@
 
 #include <memory>
 
+#include "glove_link.h"
 #include "viewer/viewer.h"
 
 namespace vrd {
@@ -18,7 +19,8 @@ std::function<int()> addViewCommand(CLI::App& app) {
       ->needs(frames);  // the last frame is known only then
   cmd->add_option("--weart", o->weart,
                   "Drive the hand from a WEART glove and send it the forces: HOST[:PORT] of the middleware (default "
-                  "port 13031)");
+                  "port 13031)")
+      ->check(CLI::Validator(weartEndpointError, "HOST[:PORT]"));
   cmd->add_option("--width", o->width, "Window width in pixels")->check(CLI::Range(320, 8192))->capture_default_str();
   cmd->add_option("--height", o->height, "Window height in pixels")
       ->check(CLI::Range(240, 8192))

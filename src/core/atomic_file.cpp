@@ -41,4 +41,16 @@ void writeFile(const std::filesystem::path& path, std::string_view text) {
   file.commit();
 }
 
+void prepareOutputFolder(const std::filesystem::path& dir) {
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) throw Error(fmt::format("{}: cannot make the output folder: {}", dir.string(), error.message()));
+  if (!std::filesystem::is_directory(dir, error))
+    throw Error(fmt::format("{}: the output folder is a file", dir.string()));
+  const std::filesystem::path probe = dir / fmt::format(".vrdeform-probe{}", ::getpid());
+  const bool writable = std::ofstream(probe, std::ios::binary).good();
+  std::filesystem::remove(probe, error);
+  if (!writable) throw Error(fmt::format("{}: cannot write in the output folder", dir.string()));
+}
+
 }  // namespace vrd

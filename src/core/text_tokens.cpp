@@ -23,6 +23,8 @@ std::string readFileBytes(const std::filesystem::path& path) {
   std::error_code error;
   const auto status = std::filesystem::status(path, error);
   if (!std::filesystem::exists(status)) throw Error(fmt::format("cannot read {}: no such file", path.string()));
+  if (std::filesystem::is_directory(status))
+    throw Error(fmt::format("cannot read {}: it is a folder, not a file", path.string()));
   if (!std::filesystem::is_regular_file(status))
     throw Error(fmt::format("cannot read {}: not a regular file", path.string()));
   std::ifstream in(path, std::ios::binary);

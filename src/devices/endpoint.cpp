@@ -1,7 +1,10 @@
 #include "endpoint.h"
 
+#include <arpa/inet.h>
+
 #include <algorithm>
 #include <charconv>
+#include <string>
 
 namespace vrd {
 namespace {
@@ -14,16 +17,13 @@ bool validHostName(std::string_view host) {
   });
 }
 
+// An IPv6 address as inet_pton reads it (so "::::" is not one), with an optional %zone.
 bool validIpv6(std::string_view host) {
-  if (host.size() < 2 || host.find(':') == std::string_view::npos) return false;
   const std::size_t zone = host.find('%');
-  const std::string_view address = host.substr(0, zone);
-  const bool addressOk = std::all_of(address.begin(), address.end(), [](char c) {
-    return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F') || c == ':' || c == '.';
-  });
-  if (!addressOk) return false;
-  if (zone == std::string_view::npos) return true;
-  return validHostName(host.substr(zone + 1));
+  const std::string address(host.substr(0, zone));
+  in6_addr parsed{};
+  if (::inet_pton(AF_INET6, address.c_str(), &parsed) != 1) return false;
+  return zone == std::string_view::npos || validHostName(host.substr(zone + 1));
 }
 
 std::optional<std::uint16_t> parsePort(std::string_view text) {

@@ -96,7 +96,9 @@ TriMesh readSurface(const std::filesystem::path& path) {
   const std::string name = path.string();
   const std::string ext = io::lowerExtension(path);
   std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) throw Error(fmt::format("{}: no such file", name));
+  const auto status = std::filesystem::status(path, error);
+  if (std::filesystem::is_directory(status)) throw Error(fmt::format("{}: is a folder, not a mesh file", name));
+  if (!std::filesystem::is_regular_file(status)) throw Error(fmt::format("{}: no such file", name));
   if (std::filesystem::file_size(path, error) == 0) throw Error(fmt::format("{}: the file is empty", name));
   if (ext == ".ply") {
     std::ifstream in(path, std::ios::binary);
@@ -178,10 +180,15 @@ void writePly(std::ostream& out, const TriMesh& mesh, bool binary) {
 
 }  // namespace
 
+void checkSurfaceOutput(const std::filesystem::path& path) {
+  if (!isSurfaceFile(path))
+    throw Error(fmt::format("{}: unknown surface format '{}' (use .obj, .off, .stl or .ply)", path.string(),
+                            io::lowerExtension(path)));
+}
+
 void writeSurface(const std::filesystem::path& path, const TriMesh& mesh, const SurfaceWriteOptions& options) {
   const std::string ext = io::lowerExtension(path);
-  if (!isSurfaceFile(path))
-    throw Error(fmt::format("{}: unknown surface format '{}' (use .obj, .off, .stl or .ply)", path.string(), ext));
+  checkSurfaceOutput(path);
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
     for (Index v : mesh.triangles[t])
       if (v >= mesh.vertices.size())

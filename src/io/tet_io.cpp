@@ -68,11 +68,15 @@ TetMesh readTetMesh(const std::filesystem::path& path, std::vector<Triangle>* fa
   return mesh;
 }
 
-void writeTetMesh(const std::filesystem::path& path, const TetMesh& mesh, const TetWriteOptions& options) {
+void checkTetMeshOutput(const std::filesystem::path& path) {
   const std::string ext = io::lowerExtension(path);
-  const bool known =
-      ext == ".node" || ext == ".ele" || ext == ".mesh" || ext == ".msh" || ext == ".vtk" || ext == ".vtu";
-  if (!known) unknownFormat(path);
+  if (!(ext == ".node" || ext == ".ele" || ext == ".mesh" || ext == ".msh" || ext == ".vtk" || ext == ".vtu"))
+    unknownFormat(path);
+}
+
+void writeTetMesh(const std::filesystem::path& path, const TetMesh& mesh, const TetWriteOptions& options) {
+  checkTetMeshOutput(path);
+  const std::string ext = io::lowerExtension(path);
   io::checkWritableMesh(mesh);
   if (ext == ".node" || ext == ".ele") return io::writeTetGen(path, mesh);
   AtomicFile file(path);

@@ -108,8 +108,13 @@ Tetrahedralisation tetrahedralise(const TriMesh& surface, const TetrahedraliseOp
   Tetrahedralisation result =
       options.mesher == Mesher::TetGen ? tetgen(surface, volume, options) : builtin(surface, volume, options);
   if (result.mesh.tets.empty())
-    throw Error(fmt::format("{} produced no tets (is the size bound {} far above the volume {}?)",
-                            toString(options.mesher), result.maxVolume, volume));
+    throw Error(options.targetTets > 0
+                    ? fmt::format("{} produced no tets: {} {} too few for this surface (its tets would be as big as "
+                                  "the body); ask for more, a few hundred at least",
+                                  toString(options.mesher), options.targetTets, options.targetTets == 1 ? "is" : "are")
+                    : fmt::format("{} produced no tets: the largest tet volume {:.4g} is not far enough below the "
+                                  "body's volume {:.4g}; give a smaller one",
+                                  toString(options.mesher), result.maxVolume, volume));
   return result;
 }
 

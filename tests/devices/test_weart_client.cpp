@@ -161,8 +161,10 @@ TEST(WeartEndpoint, ParsesHostPortForms) {
 
 TEST(WeartEndpoint, RejectsGarbage) {
   for (const char* bad :
-       {"", ":", "host:", "host:0", "host:65536", "host:12a", "host:-1", "host: 1", "[::1", "[::1]x", "[::1]:", "[]:5",
-        "[zz::1]:5", "a b:1", "host:1:2", "~:1", "h\xc3\xa9:1", "host:99999999999999999999"}) {
+       {"",          ":",        "host:",    "host:0",      "host:65536",  "host:12a",
+        "host:-1",   "host: 1",  "[::1",     "[::1]x",      "[::1]:",      "[]:5",
+        "[zz::1]:5", "a b:1",    "host:1:2", "~:1",         "h\xc3\xa9:1", "host:99999999999999999999",
+        "::::",      "[::::]:5", "1::2::3",  "[fe80::1%]:5"}) {
     const std::string message = vrd::testing::errorOf([&] { parseEndpoint(bad); });
     EXPECT_NE(message.find("WEART endpoint"), std::string::npos) << "'" << bad << "': " << message;
   }

@@ -21,6 +21,10 @@ struct SurfaceWriteOptions {
   bool binary = true;  ///< STL and PLY: binary (little-endian) or ASCII
 };
 
+/// Throws vrd::Error unless writeSurface knows `path`'s extension: refuses an output before the
+/// work that makes it.
+void checkSurfaceOutput(const std::filesystem::path& path);
+
 /// Writes by extension (.obj, .off, .stl, .ply), all or nothing. Throws vrd::Error for an
 /// unknown extension, an invalid mesh or a failed write.
 void writeSurface(const std::filesystem::path& path, const TriMesh& mesh, const SurfaceWriteOptions& options = {});

@@ -39,6 +39,10 @@ struct TetWriteOptions {
 /// .vtu data may claim at most zlib's maximum ratio, about 1032:1).
 TetMesh readTetMesh(const std::filesystem::path& path, std::vector<Triangle>* faces = nullptr);
 
+/// Throws vrd::Error unless writeTetMesh knows `path`'s extension: refuses an output before the
+/// work that makes it.
+void checkTetMeshOutput(const std::filesystem::path& path);
+
 /// Writes a tet mesh, by extension: .node or .ele (X.node, X.ele and X.face with boundaryFaces(),
 /// 1-based), .mesh, .msh (Gmsh 4.1 or 2.2 ASCII), .vtk (legacy ASCII), .vtu. Coordinates are written
 /// so that reading them back gives the same floats. Every file appears complete or not at all.
