@@ -198,7 +198,8 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log) {
   const long settleSteps = std::lround(spec.settle / double(spec.solver.timeStep));
   for (long k = 0; k < settleSteps; ++k) world.step();
   scene.settleSeconds = double(settleSteps) * spec.solver.timeStep;
-  for (const SimEvent& e : world.takeEvents()) say(log, fmt::format("event while settling: {}", e.message));
+  scene.settleEvents = world.takeEvents();
+  for (const SimEvent& e : scene.settleEvents) say(log, fmt::format("event while settling: {}", e.message));
   for (SceneBody& b : scene.bodies) {
     b.top = topPoint(world, b.id);
     if (!isFinite(b.top)) throw Error(fmt::format("body '{}' did not settle to finite positions", b.name));

@@ -236,6 +236,9 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
                    [](const PokeTrace& a, const PokeTrace& b) { return a.poke->start < b.poke->start; });
   std::size_t firstOpen = 0;
   constexpr std::size_t kEventsListed = 100;  // in summary.events; nanEvents counts them all
+  for (const SimEvent& e : scene.settleEvents)
+    if (++summary.nanEvents <= kEventsListed)
+      summary.events.push_back(fmt::format("settling, step {}: {}", e.step, e.message));
 
   HandInput* input = settings.input ? settings.input : scene.input.get();
   std::optional<HapticSession> session;

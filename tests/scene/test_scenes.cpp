@@ -276,6 +276,25 @@ TEST(SceneRun, AFailedRunStillLeavesASummarySayingSo) {
   EXPECT_EQ(j["error"], "disk full");
 }
 
+// A body that goes non-finite while settling is frozen there, and the run's summary says so (it
+// counted only the run's own steps before).
+TEST(SceneRun, ANaNWhileSettlingIsInTheSummary) {
+  SceneSpec spec = loadSceneByName("jelly");
+  spec.settle = 0.1;
+  spec.haptics.calibrate = false;
+  spec.hand.enabled = false;
+  spec.bodies.front().force = Vec3(0.0f, 1e37f, 0.0f);  // N on every particle: overflows in a step
+  BuiltScene scene = buildScene(spec);
+  ASSERT_EQ(scene.settleEvents.size(), 1u);
+  RunSettings settings;
+  settings.steps = 3;
+  const RunSummary summary = runScene(scene, settings);
+  EXPECT_EQ(summary.nanEvents, 1u);
+  ASSERT_EQ(summary.events.size(), 1u);
+  EXPECT_EQ(summary.events.front().rfind("settling, step 0: ", 0), 0u) << summary.events.front();
+  EXPECT_NE(summaryJson(summary).find("\"nan_events\": 1"), std::string::npos);
+}
+
 TEST(SceneLibrary, UnknownNamesListTheBuiltInScenes) {
   const std::string e = testing::errorOf([] { loadSceneByName("livr"); });
   EXPECT_NE(e.find("no built-in scene 'livr'"), std::string::npos) << e;
