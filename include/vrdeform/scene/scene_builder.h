@@ -57,9 +57,9 @@ struct BuiltScene {
   std::vector<SceneBody> bodies;
   HapticSessionSettings session;  ///< the hand, grasp and haptic model (tau calibrated)
   std::optional<HapticCalibration> calibration;
-  std::unique_ptr<HandInput> input;  ///< the scripted hand; null without a hand or a script/actions
-  std::vector<HandAction> actions;   ///< the actions in world coordinates (empty with a script)
-  double settleSeconds = 0.0;        ///< simulated while settling
+  std::unique_ptr<HandInput> input;    ///< the scripted hand; null without a hand or a script/actions
+  std::vector<HandAction> actions;     ///< the actions in world coordinates (empty with a script)
+  double settleSeconds = 0.0;          ///< simulated while settling
   std::vector<SimEvent> settleEvents;  ///< NaN events while settling (a run's summary counts them)
 
   const SceneBody& body(std::string_view name) const;  ///< throws vrd::Error for an unknown name
