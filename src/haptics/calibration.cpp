@@ -81,7 +81,8 @@ HapticCalibration calibrateHaptics(const World& original, BodyId body, const Hap
   const float sag = down.dot(centroid(world, body) - before);
   if (sag > 0.5f * depth)
     throw Error(fmt::format(
-        "calibration: body {} gave way as a whole ({:.1f} mm for a {:.1f} mm poke); rest it on something or pin it",
+        "calibration: body {} gave way as a whole ({:.1f} mm for a {:.1f} mm poke): it is not at rest; rest it on "
+        "something or pin it, let it settle longer, or check its size (a mesh in millimetres needs scale = 0.001)",
         body, 1e3f * sag, 1e3f * depth));
 
   const std::size_t count = world.fingertipContactCount(tip);

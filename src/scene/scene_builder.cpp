@@ -17,6 +17,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
+constexpr double kLargestPlausibleBody = 10.0;  // m across: a larger one gets a warning about units
+
 void say(const SceneLog& log, const std::string& line) {
   if (log) log(line);
 }
@@ -97,6 +99,11 @@ PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log) {
   const Eigen::AlignedBox3f box = boundsOf(out.tets.vertices);
   const Vec3 lo = box.min(), hi = box.max();
   if (!isFinite(lo) || !isFinite(hi)) throw Error(fmt::format("{}: coordinates overflow after scaling", body.mesh));
+  // Meshes often come in millimetres, which taken as metres make a body of a giant's size.
+  if (const double size = (hi - lo).maxCoeff(); size > kLargestPlausibleBody)
+    say(log, fmt::format("warning: body '{}' is {:.3g} m across (the scene's units are metres); if its mesh is in "
+                         "millimetres, scale = {:g} makes it {:.3g} m, in centimetres scale = {:g} makes it {:.3g} m",
+                         body.name, size, 1e-3 * body.scale, 1e-3 * size, 1e-2 * body.scale, 1e-2 * size));
   const Vec3 shift = body.placement == Placement::Ground
                          ? Vec3(body.position.x() - 0.5f * (lo.x() + hi.x()), body.position.y() - lo.y(),
                                 body.position.z() - 0.5f * (lo.z() + hi.z()))

@@ -698,8 +698,8 @@ OutputSpec readOutput(const Table& t) {
 }
 
 SceneSpec readScene(const Table& root, std::string_view sourceName) {
-  root.allowOnly({"format", "name", "description", "settle", "seconds", "wind", "solver", "body", "collider", "hand",
-                  "haptics", "output"});
+  root.allowOnly({"format", "name", "description", "settle", "seconds", "wind", "ground", "solver", "body", "collider",
+                  "hand", "haptics", "output"});
   if (std::optional<Field> f = root.get("format"); f && f->integer() != 1)
     f->fail(fmt::format("this vrdeform reads format 1, got {}", f->integer()));
 
@@ -723,6 +723,9 @@ SceneSpec readScene(const Table& root, std::string_view sourceName) {
     scene.bodies.push_back(std::move(body));
   }
   for (const Table& t : root.tables("collider")) scene.colliders.push_back(readCollider(t));
+  bool ground = true;  // a scene of a mesh alone stands on something
+  root.readBool("ground", ground);
+  if (ground && scene.colliders.empty()) scene.colliders.push_back(Collider::plane(Vec3::UnitY()));
   scene.hand = readHand(root.table("hand"), scene.bodies);
   scene.haptics = readHaptics(root.table("haptics"));
   scene.output = readOutput(root.table("output"));

@@ -384,7 +384,10 @@ TEST(SceneFile, AbsentKeysKeepTheirDefaults) {
   EXPECT_FALSE(b.material.particleMass.has_value());  // masses from the density
   EXPECT_EQ(b.material.density, Material().density);
   EXPECT_EQ(b.material.volume.compliance, Material().volume.compliance);
-  EXPECT_TRUE(s.colliders.empty());
+  ASSERT_EQ(s.colliders.size(), 1u);  // the ground
+  EXPECT_EQ(s.colliders[0].shape, ColliderShape::Plane);
+  EXPECT_EQ(s.colliders[0].normal, Vec3::UnitY());
+  EXPECT_EQ(s.colliders[0].center, Vec3::Zero());
 
   EXPECT_TRUE(s.hand.enabled);
   EXPECT_FALSE(s.hand.rig.fingers[int(Finger::Ring)]);  // g1
@@ -429,6 +432,14 @@ TEST(SceneFile, MaxChangeMayBeInfinite) {
   EXPECT_EQ(parse(std::string(kMinimal) + "[haptics]\nmax_change_per_ms = inf\n").haptics.settings.maxChangePerMs, inf);
   EXPECT_EQ(errorIn(std::string(kMinimal) + "[haptics]\nmax_change_per_ms = \"fast\"\n"),
             "scene.toml:4: haptics.max_change_per_ms: expected a number or \"inf\", got 'fast'");
+}
+
+TEST(SceneFile, TheGroundIsThereUnlessTheSceneHasCollidersOrTurnsItOff) {
+  EXPECT_EQ(parse(std::string(kMinimal)).colliders.size(), 1u);
+  EXPECT_TRUE(parse("ground = false\n" + std::string(kMinimal)).colliders.empty());
+  const SceneSpec own = parse(std::string(kMinimal) + "[[collider]]\ntype = \"sphere\"\nradius = 1\n");
+  ASSERT_EQ(own.colliders.size(), 1u);
+  EXPECT_EQ(own.colliders[0].shape, ColliderShape::Sphere);
 }
 
 TEST(SceneFile, ThreadsMayBeAuto) {

@@ -2,11 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "test_support.h"
+#include "vrdeform/scene/scene_file.h"
 #include "vrdeform/scene/scene_library.h"
 #include "vrdeform/scene/scene_run.h"
 
@@ -293,6 +295,21 @@ TEST(SceneRun, ANaNWhileSettlingIsInTheSummary) {
   ASSERT_EQ(summary.events.size(), 1u);
   EXPECT_EQ(summary.events.front().rfind("settling, step 0: ", 0), 0u) << summary.events.front();
   EXPECT_NE(summaryJson(summary).find("\"nan_events\": 1"), std::string::npos);
+}
+
+// A mesh in millimetres taken as metres: the build says so and what scale would fix it.
+TEST(SceneBuilder, AGiantBodyGetsAWarningAboutUnits) {
+  SceneSpec spec = parseScene("[[body]]\nmesh = \"liver_coarse.obj\"\ntets = 200\n[hand]\nenabled = false\n", "mm.toml",
+                              VRDEFORM_SHARED_DIR "/data/meshes");
+  spec.settle = 0.0;
+  spec.haptics.calibrate = false;
+  std::vector<std::string> log;
+  buildScene(spec, [&](std::string_view line) { log.emplace_back(line); });
+  const auto warning =
+      std::find_if(log.begin(), log.end(), [](const std::string& l) { return l.starts_with("warning"); });
+  ASSERT_NE(warning, log.end());
+  EXPECT_NE(warning->find("is 19"), std::string::npos) << *warning;  // m across: the liver's ~19 cm in mm
+  EXPECT_NE(warning->find("scale = 0.001 makes it 0.19"), std::string::npos) << *warning;
 }
 
 TEST(SceneLibrary, UnknownNamesListTheBuiltInScenes) {
