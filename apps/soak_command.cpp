@@ -69,8 +69,8 @@ int soak(const SoakArgs& a) {
   const std::uint64_t warm = std::max({a.steps / 10, cycleSteps, kMinWarmUp});
   if (a.steps < warm + 2 * cycleSteps)
     throw Error(
-        fmt::format("soak: {} steps are too few: the checks need a warm-up of {} steps (a tenth, at least "
-                    "one round of the hand's actions) and two more rounds of {} steps",
+        fmt::format("soak: {} steps are too few: the checks need a warm-up of {} steps (a tenth of the run, at "
+                    "least {} and one round of the hand's actions) and two more rounds of {} steps",
                     a.steps, warm, kMinWarmUp, cycleSteps));
   const std::size_t perRound = spec.hand.actions.size();
   repeatActions(spec.hand, cycle, seconds);

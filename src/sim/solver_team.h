@@ -82,7 +82,7 @@ class TeamChoice {
   void record(double seconds);
 
  private:
-  static constexpr int kWindow = 32, kTrialSteps = 16, kFirstInterval = 64, kLongestInterval = 2048;
+  static constexpr int kWindow = 32, kTrialSteps = 16, kFirstInterval = 256, kLongestInterval = 2048;
   static constexpr double kMargin = 0.9;  // the other way must be this much faster to switch to it
 
   bool team_ = false;

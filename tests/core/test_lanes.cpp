@@ -480,7 +480,7 @@ TEST(Lanes, SwitchingBetweenTheTeamAndOneThreadKeepsTheResult) {
 }
 
 // TeamChoice with made-up step times: the faster way nearly always, the other tried for up to 16
-// steps at growing intervals (64 steps, doubling up to 2,048), and back soon when the load changes.
+// steps at growing intervals (256 steps, doubling up to 2,048), and back soon when the load changes.
 int teamSteps(TeamChoice& choice, int steps, double team, double alone) {
   int onTeam = 0;
   for (int k = 0; k < steps; ++k) {
