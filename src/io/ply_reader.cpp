@@ -160,7 +160,12 @@ TriMesh readPly(const std::filesystem::path& path, const std::string& bytes) {
   bool haveVertices = false;
   for (const Element& e : elements) {
     const bool isVertex = e.name == "vertex", isFace = e.name == "face";
+    // Without properties an element takes no bytes, so nothing above bounds its count.
+    if (e.properties.empty() && !isVertex) continue;
     if (isVertex) {
+      for (const char* axis : {"x", "y", "z"})
+        if (std::none_of(e.properties.begin(), e.properties.end(), [&](const Property& p) { return p.name == axis; }))
+          throw Error(fmt::format("{}: the vertex element has no property {}", name, axis));
       haveVertices = true;
       mesh.vertices.resize(e.count, Vec3::Zero());
     }
