@@ -32,9 +32,7 @@ while [ $# -gt 0 ]; do
   shift
 done
 
-CC=clang CXX=clang++ cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVRDEFORM_FUZZ=ON \
-  -DVRDEFORM_WERROR=ON -DVRDEFORM_BUILD_TESTS=OFF -DVRDEFORM_BUILD_BENCHMARKS=OFF -DVRDEFORM_BUILD_APPS=OFF \
-  -DVRDEFORM_BUILD_RENDER=OFF >/dev/null
+# The targets, as fuzz/CMakeLists.txt declares them.
 all=()
 mapfile -t all < <(sed -n 's/^vrdeform_fuzzer(\([a-z_0-9]*\) .*/\1/p' fuzz/CMakeLists.txt)
 mapfile -t -O "${#all[@]}" all < <(sed -n 's/^foreach(format \(.*\))$/\1/p' fuzz/CMakeLists.txt | tr ' ' '\n')
@@ -48,6 +46,9 @@ for t in "${targets[@]}"; do
   printf '%s\n' "${all[@]}" | grep -qx "$t" || { echo "fuzz.sh: no target '$t' (targets: ${all[*]})" >&2; exit 2; }
   build_targets+=("vrdeform_${t}_fuzz")
 done
+CC=clang CXX=clang++ cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVRDEFORM_FUZZ=ON \
+  -DVRDEFORM_WERROR=ON -DVRDEFORM_BUILD_TESTS=OFF -DVRDEFORM_BUILD_BENCHMARKS=OFF -DVRDEFORM_BUILD_APPS=OFF \
+  -DVRDEFORM_BUILD_RENDER=OFF >/dev/null
 cmake --build "$build" --target "${build_targets[@]}" -j"${JOBS:-2}"
 
 scratch=$(mktemp -d "${TMPDIR:-/tmp}/vrdeform_fuzz.XXXXXX")
