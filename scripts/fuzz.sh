@@ -4,7 +4,7 @@
 # tests/fuzz_corpus/<target>, so that the repository's corpus is never changed. Prints the executions
 # and the time per target; fails on a crash, a sanitizer report, a leak, a timeout (-timeout, 10 s an
 # input) or an allocation over -rss_limit_mb (2 GiB), whose input is left in build/fuzz/artifacts/
-# (fix the bug, then add the input to the corpus as bad_<what>; tests/fuzz_regressions.h feeds the
+# (fix the bug, then add the input to the corpus as bad_<what>; tests/fuzz_corpus.h feeds the
 # corpora to the parsers in the unit tests).
 #
 #   scripts/fuzz.sh [--smoke] [RUNS] [TARGET...] [-- more libFuzzer flags...]
