@@ -19,7 +19,7 @@ packages=(
   libbenchmark-dev    # benchmarks
   libbullet-dev       # Bullet soft bodies: only for bench/bullet_compare (not a test)
   clang-format        # code style check
-  clang libclang-rt-14-dev   # libFuzzer for the fuzz targets (fuzz/)
+  clang libclang-rt-14-dev lld   # libFuzzer for the fuzz targets (fuzz/); lld drops their unused code
   libboost1.81-dev    # Boost.Beast (HTTP, WebSocket) for the VR server (vrdeform serve)
   chromium            # the VR page's browser test (headless, with an emulated headset)
   libepoxy-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri   # OpenGL renderer; headless on Mesa's EGL surfaceless

@@ -160,7 +160,12 @@ TriMesh readPly(const std::filesystem::path& path, const std::string& bytes) {
   bool haveVertices = false;
   for (const Element& e : elements) {
     const bool isVertex = e.name == "vertex", isFace = e.name == "face";
+    // Without properties an element takes no bytes, so nothing above bounds its count.
+    if (e.properties.empty() && !isVertex) continue;
     if (isVertex) {
+      for (const char* axis : {"x", "y", "z"})
+        if (std::none_of(e.properties.begin(), e.properties.end(), [&](const Property& p) { return p.name == axis; }))
+          throw Error(fmt::format("{}: the vertex element has no property {}", name, axis));
       haveVertices = true;
       mesh.vertices.resize(e.count, Vec3::Zero());
     }
@@ -173,16 +178,20 @@ TriMesh readPly(const std::filesystem::path& path, const std::string& bytes) {
           continue;
         }
         const double n = data.read(*prop.listCount);
-        if (n < 0 || n > 1000) throw Error(fmt::format("{}: {} {} has a list of {} items", name, e.name, i, n));
-        std::vector<Index> polygon(static_cast<std::size_t>(n));
-        for (Index& v : polygon) {
+        if (!(n >= 0 && n <= 1000 && n == std::floor(n)))  // NaN too
+          throw Error(fmt::format("{}: {} {} has a list of {} items", name, e.name, i, n));
+        // Only a face's vertex indices are kept; other lists (texture coordinates, ...) are read past.
+        const bool indices = isFace && (prop.name == "vertex_indices" || prop.name == "vertex_index");
+        std::vector<Index> polygon(indices ? static_cast<std::size_t>(n) : 0);
+        for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
           const double value = data.read(prop.type);
-          if (isFace && (value < 0 || value >= double(mesh.vertices.size()) || value != std::floor(value)))
+          if (!indices) continue;
+          if (!(value >= 0 && value < double(mesh.vertices.size()) && value == std::floor(value)))
             throw Error(fmt::format("{}: face {} refers to vertex {}, but there are {} vertices", name, i, value,
                                     mesh.vertices.size()));
-          v = static_cast<Index>(value);
+          polygon[k] = static_cast<Index>(value);
         }
-        if (!isFace || (prop.name != "vertex_indices" && prop.name != "vertex_index")) continue;
+        if (!indices) continue;
         if (!haveVertices) throw Error(fmt::format("{}: faces come before vertices", name));
         if (polygon.size() < 3) throw Error(fmt::format("{}: face {} has only {} corners", name, i, polygon.size()));
         for (std::size_t k = 1; k + 1 < polygon.size(); ++k)

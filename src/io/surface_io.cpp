@@ -13,6 +13,7 @@
 
 #include "io/binary.h"
 #include "io/extension.h"
+#include "io/off_reader.h"
 #include "io/ply_reader.h"
 #include "vrdeform/core/atomic_file.h"
 #include "vrdeform/error.h"
@@ -100,11 +101,11 @@ TriMesh readSurface(const std::filesystem::path& path) {
   if (std::filesystem::is_directory(status)) throw Error(fmt::format("{}: is a folder, not a mesh file", name));
   if (!std::filesystem::is_regular_file(status)) throw Error(fmt::format("{}: no such file", name));
   if (std::filesystem::file_size(path, error) == 0) throw Error(fmt::format("{}: the file is empty", name));
-  if (ext == ".ply") {
+  if (ext == ".ply" || ext == ".off") {
     std::ifstream in(path, std::ios::binary);
     const std::string bytes{std::istreambuf_iterator<char>(in), {}};
     if (!in && !in.eof()) throw Error(fmt::format("{}: cannot read the file", name));
-    return weld(readPly(path, bytes), name);
+    return weld(ext == ".ply" ? readPly(path, bytes) : readOff(bytes, name), name);
   }
   if (!isSurfaceFile(path))
     throw Error(fmt::format("{}: unknown surface format '{}' (use .obj, .off, .stl or .ply)", name, ext));

@@ -14,6 +14,14 @@
 namespace vrd::io {
 
 TetMesh readTetGen(const std::filesystem::path& nodePath, std::vector<Triangle>* faces);
+/// One TetGen file's bytes and its name for messages.
+struct TetGenText {
+  std::string_view text;
+  std::string name;
+};
+/// readTetGen on files already read; `face` may be null (no .face, or none wanted).
+TetMesh parseTetGen(const TetGenText& node, const TetGenText& ele, const TetGenText* face,
+                    std::vector<Triangle>* faces);
 void writeTetGen(const std::filesystem::path& anyPath, const TetMesh& mesh);
 
 TetMesh readMedit(std::string_view text, const std::string& name, std::vector<Triangle>* faces);

@@ -45,11 +45,23 @@ void skipTokens(TextTokens& in, std::int64_t n, const char* what) {
 TetMesh readTetGen(const std::filesystem::path& path, std::vector<Triangle>* faces) {
   const std::filesystem::path nodePath = sibling(path, ".node"), elePath = sibling(path, ".ele"),
                               facePath = sibling(path, ".face");
+  const std::string node = readFileBytes(nodePath);
+  if (!std::filesystem::exists(elePath))
+    throw Error(fmt::format("{}: cannot read the tets: {} is missing", nodePath.string(), elePath.string()));
+  const std::string ele = readFileBytes(elePath);
+  std::string face;
+  const bool withFaces = faces && std::filesystem::exists(facePath);
+  if (withFaces) face = readFileBytes(facePath);
+  const TetGenText faceText{face, facePath.string()};
+  return parseTetGen({node, nodePath.string()}, {ele, elePath.string()}, withFaces ? &faceText : nullptr, faces);
+}
+
+TetMesh parseTetGen(const TetGenText& node, const TetGenText& ele, const TetGenText* face,
+                    std::vector<Triangle>* faces) {
   TetMesh mesh;
   std::int64_t base = 0;
   {
-    const std::string text = readFileBytes(nodePath);
-    TextTokens in(text, nodePath.string(), '#');
+    TextTokens in(node.text, node.name, '#');
     if (in.atEnd()) in.fail("the file is empty, expected the number of nodes");
     const std::size_t n = in.count("the number of nodes", 4);
     const std::int64_t dim = in.integer("the dimension");
@@ -78,11 +90,8 @@ TetMesh readTetGen(const std::filesystem::path& path, std::vector<Triangle>* fac
     }
   }
 
-  if (!std::filesystem::exists(elePath))
-    throw Error(fmt::format("{}: cannot read the tets: {} is missing", nodePath.string(), elePath.string()));
   {
-    const std::string text = readFileBytes(elePath);
-    TextTokens in(text, elePath.string(), '#');
+    TextTokens in(ele.text, ele.name, '#');
     if (in.atEnd()) in.fail("the file is empty, expected the number of tetrahedra");
     const std::size_t n = in.count("the number of tetrahedra", 5);
     const std::int64_t nodesPerTet = in.integer("the number of nodes per tetrahedron");
@@ -98,9 +107,8 @@ TetMesh readTetGen(const std::filesystem::path& path, std::vector<Triangle>* fac
     }
   }
 
-  if (faces && std::filesystem::exists(facePath)) {
-    const std::string text = readFileBytes(facePath);
-    TextTokens in(text, facePath.string(), '#');
+  if (faces && face) {
+    TextTokens in(face->text, face->name, '#');
     if (in.atEnd()) in.fail("the file is empty, expected the number of faces");
     const std::size_t n = in.count("the number of faces", 4);
     const std::int64_t markers = in.integer("the number of boundary markers", 0, 1);
@@ -112,7 +120,7 @@ TetMesh readTetGen(const std::filesystem::path& path, std::vector<Triangle>* fac
       skipTokens(in, markers, "a boundary marker");
     }
   }
-  checkReadMesh(mesh, elePath.string());
+  checkReadMesh(mesh, ele.name);
   return mesh;
 }
 

@@ -35,6 +35,15 @@ void putCommon(std::uint8_t* at, MessageKind kind) {
 
 [[noreturn]] void bad(const std::string& what) { throw Error(what); }
 
+// At most `max` bytes of a string from the page, cut before a character, not inside one: the
+// server sends the reasons for rejecting a message back as JSON, which must be valid UTF-8 (the
+// parser has checked that the whole string is).
+std::string_view excerpt(std::string_view s, std::size_t max) {
+  if (s.size() <= max) return s;
+  while (max > 0 && (static_cast<unsigned char>(s[max]) & 0xC0) == 0x80) --max;  // a continuation byte
+  return s.substr(0, max);
+}
+
 // Scene coordinates and anything else: finite and within a kilometre.
 float number(const json& j, const std::string& where, float limit = 1e3f) {
   if (!j.is_number()) bad(fmt::format("{}: expected a number", where));
@@ -98,7 +107,7 @@ XrInput input(const json& m) {
                                : vec3(t, fmt::format("hand.tips[{}]", f));
     }
   } else {
-    bad(fmt::format("hand.source: unknown source '{}'", source.substr(0, 32)));
+    bad(fmt::format("hand.source: unknown source '{}'", excerpt(source, 32)));
   }
   return in;
 }
@@ -126,10 +135,10 @@ ClientMessage parseClientMessage(std::string_view text) {
     const auto client = m.find("client");
     if (client != m.end()) {
       if (!client->is_string()) bad("client: expected a string");
-      out.client = client->get<std::string>().substr(0, 64);
+      out.client = std::string(excerpt(client->get_ref<const std::string&>(), 64));
     }
   } else {
-    bad(fmt::format("unknown message type '{}'", t.substr(0, 32)));
+    bad(fmt::format("unknown message type '{}'", excerpt(t, 32)));
   }
   return out;
 }
