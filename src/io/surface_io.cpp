@@ -13,6 +13,7 @@
 
 #include "io/binary.h"
 #include "io/extension.h"
+#include "io/obj_reader.h"
 #include "io/off_reader.h"
 #include "io/ply_reader.h"
 #include "vrdeform/core/atomic_file.h"
@@ -60,7 +61,7 @@ TriMesh weld(const TriMesh& raw, const std::string& name) {
 
 TriMesh readWithAssimp(const std::string& name) {
   Assimp::Importer importer;
-  // Points and lines are sorted out and dropped; node transforms are applied (OBJ and STL have none).
+  // Points and lines are sorted out and dropped; node transforms are applied (STL has none).
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   const aiScene* scene = importer.ReadFile(name, aiProcess_Triangulate | aiProcess_SortByPType |
                                                      aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure);
@@ -101,11 +102,12 @@ TriMesh readSurface(const std::filesystem::path& path) {
   if (std::filesystem::is_directory(status)) throw Error(fmt::format("{}: is a folder, not a mesh file", name));
   if (!std::filesystem::is_regular_file(status)) throw Error(fmt::format("{}: no such file", name));
   if (std::filesystem::file_size(path, error) == 0) throw Error(fmt::format("{}: the file is empty", name));
-  if (ext == ".ply" || ext == ".off") {
+  if (ext == ".ply" || ext == ".off" || ext == ".obj") {
     std::ifstream in(path, std::ios::binary);
     const std::string bytes{std::istreambuf_iterator<char>(in), {}};
     if (!in && !in.eof()) throw Error(fmt::format("{}: cannot read the file", name));
-    return weld(ext == ".ply" ? readPly(path, bytes) : readOff(bytes, name), name);
+    if (ext == ".ply") return weld(readPly(path, bytes), name);
+    return weld(ext == ".off" ? readOff(bytes, name) : readObj(bytes, name), name);
   }
   if (!isSurfaceFile(path))
     throw Error(fmt::format("{}: unknown surface format '{}' (use .obj, .off, .stl or .ply)", name, ext));

@@ -97,6 +97,40 @@ TEST_F(SurfaceIo, QuadsAreTriangulatedAndSeamsWelded) {
   EXPECT_EQ(cube.triangles.size(), 12u);
 }
 
+TEST_F(SurfaceIo, ObjReadsRelativeCornersContinuedLinesAndSkipsTheRest) {
+  // A square of two triangles: negative corners, v/vt/vn forms, a continued face line, a vertex with a
+  // colour, and keywords that carry no geometry.
+  const std::string obj =
+      "mtllib a.mtl\no square\nv 0 0 0\nv 1 0 0 0.5 0.5 0.5\nv 1 1 0\nvt 0 0\nvn 0 0 1\ng side\nusemtl red\n"
+      "s off\nf 1/1/1 2//1 3/1\nv 0 1 0 # a comment\nl 1 2\np 3\nf -4 -2 \\\n -1\n";
+  const TriMesh square = readSurface(writeBytes("square.obj", obj));
+  ASSERT_EQ(square.vertices.size(), 4u);
+  ASSERT_EQ(square.triangles.size(), 2u);
+  EXPECT_EQ(square.vertices[square.triangles[1][2]], Vec3(0, 1, 0));  // -1: the last vertex above the face
+}
+
+TEST_F(SurfaceIo, ObjErrorsNameTheLine) {
+  const std::string head = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {head + "f 1 2 4\n", "bad.obj:4: face corner 4 refers to a vertex not defined above it (3 so far)"},
+      {head + "f 0 1 2\n", "bad.obj:4: face corner 0: OBJ numbers vertices from 1"},
+      {head + "f 1 2\n", "bad.obj:4: a face needs at least 3 corners, found 2"},
+      {"v 0 0\n", "bad.obj:1: a vertex needs 3 coordinates, found 2"},
+      {"# big\nv 1e39 0 0\n", "bad.obj:2: vertex coordinate 1e39 is out of range for a float"},
+      {"v 0 zero 0\n", "bad.obj:1: 'zero' is not a vertex coordinate"},
+      {head + "f 1 2 x\n", "bad.obj:4: 'x' is not a face corner"},
+      {head + "f -4 1 2\n", "bad.obj:4: face corner -4 refers to a vertex not defined above it"},
+  };
+  for (const auto& [text, says] : cases) {
+    try {
+      readSurface(writeBytes("bad.obj", text));
+      ADD_FAILURE() << text << " was accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST_F(SurfaceIo, EverySharedMeshLoadsWithItsDocumentedCounts) {
   const std::pair<const char*, std::pair<std::size_t, std::size_t>> expected[] = {
       {"bear.obj", {13826, 27648}},
