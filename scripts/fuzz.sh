@@ -68,9 +68,7 @@ for t in "${targets[@]}"; do
   [ "$max_time" -gt 0 ] && time_flag=(-max_total_time="$max_time")
   start=$(date +%s.%N)
   status=0
-  # Assimp leaks on some malformed files, inside the library (tests/lsan.supp).
   ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp \
     "$build/fuzz/vrdeform_${t}_fuzz" -runs="$runs" "${time_flag[@]}" -max_len=$max_len -timeout=10 \
     -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$build/artifacts/${t}-" "${flags[@]}" "$corpus" \
     >"$log" 2>&1 || status=$?

@@ -8,7 +8,6 @@ packages=(
   libeigen3-dev       # small fixed-size maths
   libcli11-dev        # command-line parsing
   libfmt-dev          # formatting of reports
-  libassimp-dev       # surface mesh import
   libpugixml-dev zlib1g-dev   # VTK XML tet meshes
   nlohmann-json3-dev  # WEART middleware JSON messages
   liblo-dev           # OSC output for other haptic devices and tools

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <limits>
+
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -125,11 +128,24 @@ std::int64_t TextTokens::integer(std::string_view what, std::int64_t lo, std::in
   return value;
 }
 
-double TextTokens::real(std::string_view what) {
+double TextTokens::real(std::string_view what) { return realToken(what).first; }
+
+std::pair<double, std::string_view> TextTokens::realToken(std::string_view what) {
   const std::string_view token = next(what);
   double value = 0;
   if (!parseReal(token, value)) fail(fmt::format("expected {} (a number), found '{}'", what, printable(token)));
-  return value;
+  return {value, token};
+}
+
+float TextTokens::real32(std::string_view what) {
+  const auto [value, token] = realToken(what);
+  return toFloat(value, token, what);
+}
+
+float TextTokens::toFloat(double value, std::string_view token, std::string_view what) const {
+  if (std::abs(value) > double(std::numeric_limits<float>::max()))
+    fail(fmt::format("{} {} is out of range for a float (at most 3.4e38)", what, printable(token)));
+  return static_cast<float>(value);
 }
 
 std::size_t TextTokens::count(std::string_view what, std::size_t tokensPerItem) {

@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <limits>
 #include <vector>
 
 #include "vrdeform/core/text_tokens.h"
@@ -27,16 +26,14 @@ std::vector<std::string_view> words(std::string_view line) {
   return out;
 }
 
-float coordinate(io::TextTokens& in, std::string_view word) {
+float coordinate(const io::TextTokens& in, std::string_view word) {
   double x = 0.0;
   if (!io::parseReal(word, x)) in.fail(fmt::format("'{}' is not a vertex coordinate", io::printable(word)));
-  if (std::abs(x) > double(std::numeric_limits<float>::max()))
-    in.fail(fmt::format("vertex coordinate {} is out of range for a float (at most 3.4e38)", io::printable(word)));
-  return static_cast<float>(x);
+  return in.toFloat(x, word, "vertex coordinate");
 }
 
 // A face corner's vertex: the number before the first '/', 1-based, or negative from the last vertex.
-Index corner(io::TextTokens& in, std::string_view word, std::size_t vertexCount) {
+Index corner(const io::TextTokens& in, std::string_view word, std::size_t vertexCount) {
   const std::string_view number = word.substr(0, word.find('/'));
   std::int64_t i = 0;
   if (!io::parseInteger(number, i)) in.fail(fmt::format("'{}' is not a face corner", io::printable(word)));

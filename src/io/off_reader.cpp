@@ -31,7 +31,7 @@ TriMesh readOff(std::string_view text, const std::string& name) {
   mesh.vertices.resize(vertexCount);
   for (Vec3& v : mesh.vertices) {
     double x[4] = {0, 0, 0, 1};
-    for (int k = 0; k < (homogeneous ? 4 : 3); ++k) x[k] = in.real("a vertex coordinate");
+    for (int k = 0; k < (homogeneous ? 4 : 3); ++k) x[k] = in.real32("vertex coordinate");
     v = Vec3(static_cast<float>(x[0] / x[3]), static_cast<float>(x[1] / x[3]), static_cast<float>(x[2] / x[3]));
     in.restOfLine();  // normal, colour, texture coordinates
   }

@@ -1,12 +1,9 @@
 #include "vrdeform/io/surface_io.h"
 
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
 #include <fmt/format.h>
 #include <fmt/ostream.h>
 
 #include <algorithm>
-#include <assimp/Importer.hpp>
 #include <bit>
 #include <fstream>
 #include <unordered_map>
@@ -16,6 +13,7 @@
 #include "io/obj_reader.h"
 #include "io/off_reader.h"
 #include "io/ply_reader.h"
+#include "io/stl_reader.h"
 #include "vrdeform/core/atomic_file.h"
 #include "vrdeform/error.h"
 
@@ -59,34 +57,6 @@ TriMesh weld(const TriMesh& raw, const std::string& name) {
   return mesh;
 }
 
-TriMesh readWithAssimp(const std::string& name) {
-  Assimp::Importer importer;
-  // Points and lines are sorted out and dropped; node transforms are applied (STL has none).
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene = importer.ReadFile(name, aiProcess_Triangulate | aiProcess_SortByPType |
-                                                     aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure);
-  if (!scene) throw Error(fmt::format("{}: cannot read: {}", name, importer.GetErrorString()));
-  TriMesh raw;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh& part = *scene->mMeshes[m];
-    const auto offset = static_cast<Index>(raw.vertices.size());
-    for (unsigned v = 0; v < part.mNumVertices; ++v)
-      raw.vertices.emplace_back(part.mVertices[v].x, part.mVertices[v].y, part.mVertices[v].z);
-    for (unsigned f = 0; f < part.mNumFaces; ++f) {
-      const aiFace& face = part.mFaces[f];
-      if (face.mNumIndices != 3) continue;
-      Triangle t;
-      for (int k = 0; k < 3; ++k) {
-        if (face.mIndices[k] >= part.mNumVertices)
-          throw Error(fmt::format("{}: face {} refers to a missing vertex", name, f));
-        t[k] = offset + face.mIndices[k];
-      }
-      raw.triangles.push_back(t);
-    }
-  }
-  return raw;
-}
-
 }  // namespace
 
 bool isSurfaceFile(const std::filesystem::path& path) {
@@ -102,16 +72,15 @@ TriMesh readSurface(const std::filesystem::path& path) {
   if (std::filesystem::is_directory(status)) throw Error(fmt::format("{}: is a folder, not a mesh file", name));
   if (!std::filesystem::is_regular_file(status)) throw Error(fmt::format("{}: no such file", name));
   if (std::filesystem::file_size(path, error) == 0) throw Error(fmt::format("{}: the file is empty", name));
-  if (ext == ".ply" || ext == ".off" || ext == ".obj") {
-    std::ifstream in(path, std::ios::binary);
-    const std::string bytes{std::istreambuf_iterator<char>(in), {}};
-    if (!in && !in.eof()) throw Error(fmt::format("{}: cannot read the file", name));
-    if (ext == ".ply") return weld(readPly(path, bytes), name);
-    return weld(ext == ".off" ? readOff(bytes, name) : readObj(bytes, name), name);
-  }
   if (!isSurfaceFile(path))
     throw Error(fmt::format("{}: unknown surface format '{}' (use .obj, .off, .stl or .ply)", name, ext));
-  return weld(readWithAssimp(name), name);
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(in), {}};
+  if (!in && !in.eof()) throw Error(fmt::format("{}: cannot read the file", name));
+  if (ext == ".ply") return weld(readPly(path, bytes), name);
+  if (ext == ".off") return weld(readOff(bytes, name), name);
+  if (ext == ".stl") return weld(readStl(bytes, name), name);
+  return weld(readObj(bytes, name), name);
 }
 
 namespace {

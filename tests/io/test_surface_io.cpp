@@ -131,6 +131,44 @@ TEST_F(SurfaceIo, ObjErrorsNameTheLine) {
   }
 }
 
+TEST_F(SurfaceIo, StlTellsBinaryFromAsciiByItsSize) {
+  // A binary file whose header starts with "solid", as some exporters write them.
+  writeSurface(file("b.stl"), octahedron(), {true});
+  std::string bytes = readBytes(file("b.stl"));
+  bytes.replace(0, 5, "solid");
+  EXPECT_EQ(readSurface(writeBytes("solid_header.stl", bytes)).triangles.size(), 8u);
+  // ASCII: two solids, a quad loop fanned, no final endsolid.
+  const std::string ascii =
+      "solid a\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\n"
+      "endloop\nendfacet\nendsolid a\nsolid b\nfacet normal 0 0 1\nouter loop\nvertex 0 0 1\nvertex 1 0 1\n"
+      "vertex 1 1 1\nendloop\nendfacet\n";
+  const TriMesh mesh = readSurface(writeBytes("two.stl", ascii));
+  EXPECT_EQ(mesh.triangles.size(), 3u);
+  EXPECT_EQ(mesh.vertices.size(), 7u);
+}
+
+TEST_F(SurfaceIo, StlErrorsSayWhatIsWrong) {
+  writeSurface(file("b.stl"), octahedron(), {true});
+  const std::string binary = readBytes(file("b.stl"));
+  const std::pair<std::string, std::string> cases[] = {
+      {binary.substr(0, binary.size() - 1), "a binary STL of 8 facets takes 484 bytes, the file has 483"},
+      {"hello", "too short for a binary STL (84) and not ASCII STL"},
+      {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\n",
+       "bad.stl:5: a facet needs at least 3 vertices, found 2"},
+      {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 -1e39 0\n",
+       "bad.stl:6: vertex coordinate -1e39 is out of range for a float"},
+      {"solid x\nfacet normal 0 0 1\nouter lop\n", "bad.stl:3: expected 'loop', found 'lop'"},
+  };
+  for (const auto& [text, says] : cases) {
+    try {
+      readSurface(writeBytes("bad.stl", text));
+      ADD_FAILURE() << text << " was accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST_F(SurfaceIo, EverySharedMeshLoadsWithItsDocumentedCounts) {
   const std::pair<const char*, std::pair<std::size_t, std::size_t>> expected[] = {
       {"bear.obj", {13826, 27648}},
@@ -180,7 +218,7 @@ TEST_F(SurfaceIo, MissingEmptyAndGarbageFilesAreErrors) {
   expectError(writeBytes("empty.stl", ""), "empty");
   expectError(writeBytes("words.obj", "hello world\nthis is not a mesh\n"), "");
   expectError(writeBytes("nan.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "non-finite");
-  expectError(writeBytes("inf.off", "OFF\n3 1 0\n0 0 0\n1e39 0 0\n0 1 0\n3 0 1 2\n"), "non-finite");
+  expectError(writeBytes("inf.off", "OFF\n3 1 0\n0 0 0\n1e39 0 0\n0 1 0\n3 0 1 2\n"), "inf.off:4: vertex coordinate 1e39 is out of range");
   expectError(writeBytes("points.off", "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n"), "");
   expectError(writeBytes("bad.xyz", "v 0 0 0\n"), "");
 

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <utility>
 
 namespace vrd::io {
 
@@ -36,6 +37,10 @@ class TextTokens {
   /// An integer in [lo, hi]; anything else throws, naming `what`.
   std::int64_t integer(std::string_view what, std::int64_t lo, std::int64_t hi);
   double real(std::string_view what);
+  /// A real number that a float holds: beyond +-3.4e38 throws "... out of range for a float".
+  float real32(std::string_view what);
+  /// `value` (parsed from `token`) as a float, or the same error.
+  float toFloat(double value, std::string_view token, std::string_view what) const;
   /// A count of items that take at least `tokensPerItem` tokens each. Throws when it is negative or when
   /// the rest of the file is too short to hold that many, so that a header claiming 10^12 elements is
   /// rejected before anything is reserved.
@@ -60,6 +65,7 @@ class TextTokens {
 
  private:
   void skipSpace();
+  std::pair<double, std::string_view> realToken(std::string_view what);
 
   std::string_view text_;
   std::string name_;

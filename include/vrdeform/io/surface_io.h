@@ -10,8 +10,7 @@ namespace vrd {
 /// Whether the extension names a surface format (.obj, .off, .stl, .ply, any case).
 bool isSurfaceFile(const std::filesystem::path& path);
 
-/// Reads a surface: OBJ and STL through Assimp (the format comes from the file's content and
-/// extension), OFF and PLY with readers of our own.
+/// Reads a surface (the format from the extension; STL binary or ASCII from the content).
 /// Polygons are triangulated, and corners at identical positions become one vertex (STL stores
 /// none shared; OBJ seams split them), numbered in order of first use by a face; vertices no face
 /// uses are dropped. Throws vrd::Error for a missing, unreadable, truncated or malformed file, a
