@@ -47,7 +47,7 @@ HandFrame MouseHand::update(const MouseState& mouse, const PosedScene& scene, co
           const Vec3 b = plus ? plus->point : Vec3(inside + radius_ * axis_);
           centre_ = 0.5f * (a + b);
           const float width = (b - a).dot(axis_);
-          open_ = width + 2.0f * radius_ + 0.02f;  // 2 cm clear: opening to it outdoes the grasp's hysteresis
+          open_ = width + 2.0f * radius_ + 0.02f;  // 1 cm clear of each side
           closed_ = std::max(width + 2.0f * radius_ * (1.0f - settings.pinchDepth), radius_);
           aperture_ = open_;
           grabbed_ = onViewPlane(ray, centre_, forward);
@@ -74,7 +74,9 @@ HandFrame MouseHand::update(const MouseState& mouse, const PosedScene& scene, co
       shift_ = onViewPlane(ray, grabbed_, forward) - grabbed_;
     } else {
       aperture_ += settings.closingSpeed * dt;
-      if (aperture_ >= open_) mode_ = Mode::Idle;
+      // 2 cm wider than the pinch began: a grasp began at that aperture or inside it, and 2 cm outdo
+      // its 1 cm hysteresis, so it always lets go before the fingers park.
+      if (aperture_ >= open_ + 0.02f) mode_ = Mode::Idle;
     }
     const Vec3 c = centre_ + shift_;
     frame.fingertips[thumb] = c - 0.5f * aperture_ * axis_;

@@ -386,7 +386,7 @@ void validateAt(const Table& t, std::string_view prefix, F&& validate) {
 
 SolverSettings readSolver(const Table& t) {
   t.allowOnly({"rate", "dt", "substeps", "iterations", "gravity", "linear_damping", "simd", "threads",
-               "fuse_strain_volume", "measure_residuals", "tolerance"});
+               "fuse_strain_volume", "measure_residuals", "tolerance", "warm_start"});
   t.exclusive("rate", "dt");
   SolverSettings s;
   if (std::optional<Field> f = t.get("rate")) s.timeStep = 1.0 / double(f->integer(1, 100000));
@@ -407,6 +407,7 @@ SolverSettings readSolver(const Table& t) {
   s.measureResiduals = true;  // the scene default: runs and the viewer show how converged each step is
   t.readBool("measure_residuals", s.measureResiduals);
   t.readNumber("tolerance", s.tolerance, kNonNegative);
+  t.readBool("warm_start", s.warmStart);
   validateAt(t, "solver", [&] { validateSolverSettings(s); });
   return s;
 }

@@ -31,6 +31,11 @@ struct LaneSweeps {
   void (*strainVolume)(const StrainConstraint* strain, const VolumeConstraint* volume, std::size_t begin,
                        std::size_t end, float* strainLambda, float* volumeLambda, std::size_t tets,
                        const ConstraintDamping& damping, bool damped, const Range& r);
+  /// the warm start's moves of `tets` tets' strain multipliers, and of volume multipliers
+  void (*warmStrain)(const StrainConstraint* c, std::size_t begin, std::size_t end, const float* lambda,
+                     std::size_t tets, const Range& r);
+  void (*warmVolume)(const VolumeConstraint* c, std::size_t begin, std::size_t end, const float* lambda,
+                     const Range& r);
   /// eq. 25's sums over particles [begin, end)
   void (*shapeMatchSums)(const Point* p, const Vec3* restOffsets, const float* mass, std::size_t begin, std::size_t end,
                          ShapeMatchSums& out);
@@ -68,6 +73,8 @@ LaneSweeps makeLaneSweeps() {
         damped ? strainVolume<T, true>(s, v, begin, end, strainLambda, volumeLambda, tets, damping, r)
                : strainVolume<T, false>(s, v, begin, end, strainLambda, volumeLambda, tets, damping, r);
       },
+      warmStrain<T>,
+      warmVolume<T>,
       shapeMatchSumsOf<T>,
       shapeMatchParticles<T>,
   };

@@ -266,6 +266,47 @@ VRD_SWEEP void strainVolume(const StrainConstraint* strain, const VolumeConstrai
   forBatches<T>(begin, end, batch, strain, volume);
 }
 
+// The warm start (SolverSettings::warmStart) of tets [begin, end): each corner k moves by
+// w_k sum_c lambda_c grad_k C_c of the tet's six strain multipliers, with the gradients where the
+// last substep ended (r.start): grad_k C_ij = a_k[i] f_j + a_k[j] f_i (eq. 34), gathered as
+// sum_i a_k[i] u_i.
+template <typename T>
+VRD_SWEEP void warmStrain(const StrainConstraint* constraints, std::size_t begin, std::size_t end, const float* lambdas,
+                          std::size_t tets, const Range& r) {
+  const auto batch = [&](std::size_t first, std::size_t count, const StrainConstraint* c) {
+    Gathered<T, 4, true> g(c, count, r.pred, r.start);
+    VecOf<T> a[4], f[3];
+    strainWeightsOf<T>(c, a);
+    deformationColumns(g.xStart, a, f);
+    T l[kStrainComponents];  // 00, 11, 22, 01, 02, 12
+    for (int k = 0; k < kStrainComponents; ++k) l[k] = loadLanes<T>(lambdas + k * tets + first, count);
+    const T two = splat<T>(2.0f);
+    const VecOf<T> u[3] = {two * l[0] * f[0] + l[3] * f[1] + l[4] * f[2], l[3] * f[0] + two * l[1] * f[1] + l[5] * f[2],
+                           l[4] * f[0] + l[5] * f[1] + two * l[2] * f[2]};
+    VecOf<T> dp[4];
+    for (int k = 0; k < 4; ++k) dp[k] = g.w[k] * (a[k][0] * u[0] + a[k][1] * u[1] + a[k][2] * u[2]);
+    g.move(dp);
+    g.store(r.pred);
+  };
+  forBatches<T>(begin, end, batch, constraints);
+}
+
+// The same for volume constraints: w_k lambda grad_k C (eqs. 18-21) where the last substep ended.
+template <typename T>
+VRD_SWEEP void warmVolume(const VolumeConstraint* constraints, std::size_t begin, std::size_t end, const float* lambdas,
+                          const Range& r) {
+  const auto batch = [&](std::size_t first, std::size_t count, const VolumeConstraint* c) {
+    Gathered<T, 4, true> g(c, count, r.pred, r.start);
+    const auto e = evalVolume(g.xStart[0], g.xStart[1], g.xStart[2], g.xStart[3], splat<T>(0.0f));
+    const T lambda = loadLanes<T>(lambdas + first, count);
+    VecOf<T> dp[4];
+    for (int k = 0; k < 4; ++k) dp[k] = (g.w[k] * lambda) * e.grad[k];
+    g.move(dp);
+    g.store(r.pred);
+  };
+  forBatches<T>(begin, end, batch, constraints);
+}
+
 // Bending, a level (BodyModel::bendLevels) at a time; flattened, as the other sweeps: evalBend and
 // projectScalar as calls took 29% more time one at a time.
 template <typename T, bool Damped>

@@ -93,8 +93,15 @@ World::TeamSlot::~TeamSlot() = default;
 
 void World::setSettings(const SolverSettings& settings) {
   validateSolverSettings(settings);
+  // The multipliers scale with h^2: a warm start from another substep size would be wrong.
+  const bool cold = settings.timeStep != settings_.timeStep || settings.substeps != settings_.substeps ||
+                    settings.warmStart != settings_.warmStart;
   settings_ = settings;
+  if (cold)
+    for (BodyId id = 0; id < bodies_.size(); ++id) coldStart(id);
 }
+
+void World::coldStart(BodyId id) { clearMultipliers(bodies_[id]); }
 
 BodyId World::addBody(std::shared_ptr<const BodyModel> model, const Vec3& translation, const Quat& rotation) {
   if (!model) throw Error("addBody: no model");
@@ -134,6 +141,7 @@ BodyId World::addBody(std::shared_ptr<const BodyModel> model, const Vec3& transl
     body.initialPositions.push_back(p.pos);
     local_.push_back(p);
     predicted_.push_back(p);
+    inertial_.push_back(p);
     particles_.x.push_back({worldOf(body.origin, p.pos), p.w});
     particles_.v.push_back(Vec3::Zero());
     particles_.force.push_back(Vec3::Zero());
@@ -156,7 +164,7 @@ void World::resetBody(BodyId id) {
   }
   frameColliders();
   frameFingertips();
-  clearMultipliers(b);
+  coldStart(id);
   b.shapeMatchRotation = Eigen::Quaterniond::Identity();
   b.state = BodyState::Active;
 }
@@ -328,15 +336,18 @@ void World::step() {
   ++stepCount_;
 }
 
-// A world position that differs from the one published is the caller's: it moves the particle.
+// A world position that differs from the one published is the caller's: it moves the particle,
+// and its body starts cold (the last substep's moves belong to another shape).
 void World::ingest() {
   for (BodyId id = 0; id < bodies_.size(); ++id) {
     const Body& b = bodies_[id];
+    bool moved = false;
     for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i) {
       const Point& x = particles_.x[i];
-      if (x.pos != worldOf(b.origin, local_[i].pos)) local_[i].pos = frameOf(b.origin, x.pos);
+      if (x.pos != worldOf(b.origin, local_[i].pos)) local_[i].pos = frameOf(b.origin, x.pos), moved = true;
       local_[i].w = predicted_[i].w = x.w;
     }
+    if (moved) coldStart(id);
   }
 }
 
@@ -418,7 +429,8 @@ void World::substeps(const SolverTeam& team) {
       frameFingertips(double(s) / n, double(s + 1) / n);
     }
     predict(h, team);
-    team.barrier();  // detection reads the fingertips' new centres
+    team.barrier();                                  // detection reads the fingertips' new centres
+    if (settings_.warmStart) warmStart(plan, team);  // before detection, which sees where it puts them
     detectContacts(team);
     startDeformations(plan, team);  // its closing barrier also closes detection
     // Iterations: all of them, or (adaptive) until the largest correction is within the tolerance.
@@ -455,6 +467,7 @@ std::pair<Index, Index> World::particlesOf(const Body& b, const SolverTeam& team
 void World::predict(float h, const SolverTeam& team) {
   StageTimer timer(report_.times, Stage::Predict, settings_.timeStages && team.leader());
   const float keep = std::max(0.0f, 1.0f - settings_.linearDamping * h);
+  const bool warm = settings_.warmStart;
   for (const Body& b : bodies_) {
     if (b.state != BodyState::Active) continue;
     for (auto [i, end] = particlesOf(b, team); i < end; ++i) {
@@ -462,6 +475,7 @@ void World::predict(float h, const SolverTeam& team) {
       Vec3& v = particles_.v[i];
       if (x.w > 0.0f) v = keep * v + h * (settings_.gravity + x.w * particles_.force[i]);  // damp, then add forces
       predicted_[i] = {x.pos + h * v, x.w};  // kinematic particles follow their velocity
+      if (warm) inertial_[i] = predicted_[i];
     }
   }
 }
@@ -476,6 +490,11 @@ void World::detectContacts(const SolverTeam& team) {
   MemberContacts* const own = team.leader() ? nullptr : &memberContacts_[std::size_t(team.index)];
   std::vector<ColliderContact>& collider = own ? own->collider : colliderContacts_;
   std::vector<FingertipContact>& fingertip = own ? own->fingertip : fingertipContacts_;
+  if (settings_.warmStart && team.leader()) {  // kept to carry their multipliers over (resetMultipliers)
+    previousColliderContacts_.swap(colliderContacts_);
+    previousFingertipContacts_.swap(fingertipContacts_);
+    previousTriangleContacts_.swap(fingertipTriangleContacts_);
+  }
   collider.clear();
   fingertip.clear();
   detectParticleContacts(team, collider, fingertip);
@@ -561,10 +580,96 @@ void World::detectTriangleContacts() {
   }
 }
 
+namespace {
+
+// For each contact of `now`, the index of the same contact in `before` (or npos): both lists in
+// the order detection makes them, by particle and then by collider or fingertip.
+template <typename Contact, typename Other>
+std::vector<std::size_t> sameContacts(const std::vector<Contact>& before, const std::vector<Contact>& now,
+                                      Other other) {
+  std::vector<std::size_t> out(now.size(), std::string::npos);
+  const auto key = [&](const Contact& c) { return std::pair{c.particle, c.*other}; };
+  for (std::size_t i = 0, j = 0; i < now.size(); ++i) {
+    while (j < before.size() && key(before[j]) < key(now[i])) ++j;
+    if (j < before.size() && key(before[j]) == key(now[i])) out[i] = j;
+  }
+  return out;
+}
+
+// A contact list's multipliers for the contacts now detected: each carried over from the same
+// contact in the last substep, else zero.
+template <typename T>
+void carry(std::vector<T>& lambdas, const std::vector<std::size_t>& from, const T& zero) {
+  std::vector<T> out(from.size(), zero);
+  for (std::size_t i = 0; i < from.size(); ++i)
+    if (from[i] != std::string::npos) out[i] = lambdas[from[i]];
+  lambdas = std::move(out);
+}
+
+}  // namespace
+
 // The bodies' multipliers by the team; the contacts' and attachments' (once detected) by the leader.
+// With a warm start, a contact found again keeps its multipliers and pushes its particles as it did
+// in the last substep, so that the pushes balance the bodies' (warmStart): a fingertip held still
+// against a body at rest leaves it where it was, whatever the number of iterations.
 void World::resetMultipliers(const SolverTeam& team) {
-  for (Body& b : bodies_) clearMultipliers(b, team);
+  if (!settings_.warmStart)
+    for (Body& b : bodies_) clearMultipliers(b, team);
+
   if (!team.leader()) return;
+  if (settings_.warmStart) {
+    // Each push along the contact's direction at the inertial predictions, where the bodies' warm
+    // start takes its gradients: at rest, the two cancel.
+    Point* const pred = predicted_.data();
+    const Point* const start = inertial_.data();
+    for (std::size_t a = 0; a < attachments_.size(); ++a)  // C = x - target: grad C^T lambda is lambda
+      if (const Index p = attachments_[a].particle; p != kNoParticle) pred[p].pos += pred[p].w * attachmentLambda_[a];
+    const std::vector<std::size_t> collider =
+        sameContacts(previousColliderContacts_, colliderContacts_, &ColliderContact::collider);
+    carry(contactNormalLambda_, collider, 0.0f);
+    carry(contactFrictionLambda_, collider, Vec3(Vec3::Zero()));
+    for (std::size_t c = 0; c < colliderContacts_.size(); ++c) {
+      const ColliderContact& con = colliderContacts_[c];
+      Point& q = pred[con.particle];
+      const Vec3 n =
+          closestSurface(frameCollider(particleBody_[con.particle], con.collider), start[con.particle].pos).normal;
+      q.pos += q.w * (contactNormalLambda_[c] * n + contactFrictionLambda_[c]);
+    }
+    const std::vector<std::size_t> tip =
+        sameContacts(previousFingertipContacts_, fingertipContacts_, &FingertipContact::fingertip);
+    carry(fingertipLambda_, tip, 0.0f);
+    carry(fingertipFrictionLambda_, tip, Vec3(Vec3::Zero()));
+    for (std::size_t c = 0; c < fingertipContacts_.size(); ++c) {
+      const FingertipContact& con = fingertipContacts_[c];
+      const Fingertip& f = frameFingertip(particleBody_[con.particle], con.fingertip);
+      Point& q = pred[con.particle];
+      const Vec3 n = evalSphereContact(start[con.particle].pos, f.center, f.radius).n;
+      q.pos += q.w * (fingertipLambda_[c] * n + fingertipFrictionLambda_[c]);
+    }
+    std::vector<std::size_t> triangle(fingertipTriangleContacts_.size(), std::string::npos);
+    const auto sameTriangle = [](const FingertipTriangleContact& a, const FingertipTriangleContact& b) {
+      return a.fingertip == b.fingertip && std::equal(std::begin(a.i), std::end(a.i), std::begin(b.i));
+    };
+    for (std::size_t c = 0; c < triangle.size(); ++c)  // few: those under the fingertips
+      for (std::size_t d = 0; d < previousTriangleContacts_.size(); ++d)
+        if (sameTriangle(fingertipTriangleContacts_[c], previousTriangleContacts_[d])) triangle[c] = d;
+    carry(fingertipTriangleLambda_, triangle, 0.0f);
+    carry(fingertipTriangleFrictionLambda_, triangle, Vec3(Vec3::Zero()));
+    fingertipTriangleImpulse_.assign(fingertipTriangleContacts_.size(), {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
+    for (std::size_t c = 0; c < fingertipTriangleContacts_.size(); ++c) {
+      if (fingertipTriangleLambda_[c] == 0.0f) continue;
+      const FingertipTriangleContact& con = fingertipTriangleContacts_[c];
+      const Fingertip& f = frameFingertip(particleBody_[con.i[0]], con.fingertip);
+      const TriangleContactEval<float> e = evalFingertipTriangleContact(start[con.i[0]].pos, start[con.i[1]].pos,
+                                                                        start[con.i[2]].pos, f.center, f.radius);
+      for (int k = 0; k < 3; ++k) {  // corner k: b_k (-n lambda + lambda_t), as solveWorldConstraints pushes
+        fingertipTriangleImpulse_[c][k] =
+            e.b[k] * (fingertipTriangleFrictionLambda_[c] - fingertipTriangleLambda_[c] * e.n);
+        pred[con.i[k]].pos += pred[con.i[k]].w * fingertipTriangleImpulse_[c][k];
+      }
+    }
+    return;
+  }
   std::fill(attachmentLambda_.begin(), attachmentLambda_.end(), Vec3::Zero());
   contactNormalLambda_.assign(colliderContacts_.size(), 0.0f);
   contactFrictionLambda_.assign(colliderContacts_.size(), Vec3::Zero());
@@ -989,26 +1094,25 @@ double World::volumeLoss(BodyId id) const {
   return v0 > 0.0 ? (v0 - volume(id)) / v0 : 0.0;
 }
 
-std::vector<Vec3> World::particleMaterialForces(BodyId id) const {
-  const Body& b = bodies_.at(id);
+namespace {
+
+// Each of a body's constraints with its multiplier (the tets' only with `tets`): add(particles,
+// grad C at positions x, lambda). The generalised forces are lambda grad C / h^2; the shape
+// match's multipliers are its moves.
+template <typename Add>
+void forEachMultiplier(const Body& b, const Point* x, bool tets, Add&& add) {
   const BodyModel& m = *b.model;
-  const float h = substepSize(), invH2 = 1.0f / (h * h);
-  const Point* x = local_.data() + b.firstParticle;
-  std::vector<Vec3> f(b.particleCount, Vec3::Zero());
-  auto add = [&](const auto& idx, const auto& grad, float lambda) {
-    for (std::size_t k = 0; k < std::size(idx); ++k) f[idx[k]] += lambda * invH2 * grad[k];
-  };
   for (std::size_t c = 0; c < m.distance.size(); ++c) {
     const auto& con = m.distance[c];
     const Vec3 n = evalDistance(x[con.i[0]].pos, x[con.i[1]].pos, con.restLength).n;
     add(con.i, std::array<Vec3, 2>{n, -n}, b.distanceLambda[c]);
   }
-  for (std::size_t c = 0; c < m.volume.size(); ++c) {
+  for (std::size_t c = 0; tets && c < m.volume.size(); ++c) {
     const auto& con = m.volume[c];
     add(con.i, evalVolume(x[con.i[0]].pos, x[con.i[1]].pos, x[con.i[2]].pos, x[con.i[3]].pos, con.restVolume).grad,
         b.volumeLambda[c]);
   }
-  for (std::size_t c = 0; c < m.strain.size(); ++c) {
+  for (std::size_t c = 0; tets && c < m.strain.size(); ++c) {
     const auto& con = m.strain[c];
     for (int k = 0; k < kStrainComponents; ++k)
       add(con.i,
@@ -1021,8 +1125,48 @@ std::vector<Vec3> World::particleMaterialForces(BodyId id) const {
     add(con.i, evalBend(x[con.i[0]].pos, x[con.i[1]].pos, x[con.i[2]].pos, x[con.i[3]].pos, con.restAngle).grad,
         b.bendLambda[c]);
   }
+}
+
+}  // namespace
+
+std::vector<Vec3> World::particleMaterialForces(BodyId id) const {
+  const Body& b = bodies_.at(id);
+  const float h = substepSize(), invH2 = 1.0f / (h * h);
+  std::vector<Vec3> f(b.particleCount, Vec3::Zero());
+  forEachMultiplier(b, local_.data() + b.firstParticle, true, [&](const auto& idx, const auto& grad, float lambda) {
+    for (std::size_t k = 0; k < std::size(idx); ++k) f[idx[k]] += lambda * invH2 * grad[k];
+  });
   for (std::size_t i = 0; i < b.shapeMatchLambda.size(); ++i) f[i] += b.shapeMatchLambda[i] * invH2;
   return f;
+}
+
+// The warm start (SolverSettings::warmStart): each prediction p~ moves by w grad C(p~)^T lambda of
+// the last substep's multipliers, so that the multipliers and the positions start consistent
+// (M (p - p~) = grad C^T lambda), as XPBD's update assumes. The tets in lanes, colour by colour,
+// by the team; the rest by the leader.
+void World::warmStart(const sweeps::LanePlan& plan, const SolverTeam& team) {
+  for (Body& b : bodies_) {
+    if (b.state != BodyState::Active) continue;
+    const BodyModel& m = *b.model;
+    const sweeps::Range r{predicted_.data() + b.firstParticle, inertial_.data() + b.firstParticle, 0.0f, nullptr};
+    if (!m.strain.empty())
+      sweepColours(m.tetColours, m.tetGroups, m.strain.size(), plan, team,
+                   [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
+                     s.warmStrain(m.strain.data(), begin, end, b.strainLambda.data(), m.strain.size(), r);
+                   });
+    if (!m.volume.empty())
+      sweepColours(m.tetColours, m.tetGroups, m.volume.size(), plan, team,
+                   [&](const sweeps::LaneSweeps& s, std::size_t begin, std::size_t end) {
+                     s.warmVolume(m.volume.data(), begin, end, b.volumeLambda.data(), r);
+                   });
+    if (!team.leader()) continue;
+    Point* const p = r.pred;
+    forEachMultiplier(b, r.start, false, [&](const auto& idx, const auto& grad, float lambda) {
+      for (std::size_t k = 0; k < std::size(idx); ++k) p[idx[k]].pos += p[idx[k]].w * lambda * grad[k];
+    });
+    for (std::size_t i = 0; i < b.shapeMatchLambda.size(); ++i) p[i].pos += p[i].w * b.shapeMatchLambda[i];
+  }
+  team.barrier();
 }
 
 std::vector<Vec3> World::particleConstraintForces(BodyId id) const {

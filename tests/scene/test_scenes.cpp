@@ -135,6 +135,33 @@ TEST_P(EveryPoke, IsSmoothMonotoneAndSteady) {
 
 INSTANTIATE_TEST_SUITE_P(Builtin, EveryPoke, ::testing::Values("furball", "liver", "balloon", "jelly", "bear"));
 
+// The liver's poke, held for a second, read in newtons: cold (the scene as it is, 8 x 5) far from a
+// converged run of the same scene (2 x the substeps, 4 x the iterations); with a warm start
+// (SolverSettings::warmStart), which makes the held body a fixed point of any number of
+// iterations, within 5% of it.
+TEST(Scenes, AWarmStartedPokeReadsTheConvergedNewtons) {
+#ifdef __SANITIZE_ADDRESS__
+  GTEST_SKIP() << "eight times the scene's arithmetic: the release build checks it";
+#endif
+  const auto peak = [](bool warm, int substeps, int iterations) {
+    SceneSpec spec = loadSceneByName("liver");
+    spec.solver.warmStart = warm;
+    spec.solver.substeps *= substeps;
+    spec.solver.iterations *= iterations;
+    BuiltScene scene = buildScene(spec);
+    RunSettings settings;
+    settings.steps = std::uint64_t(std::lround(4.5 / spec.solver.timeStep));
+    const RunSummary r = runScene(scene, settings);
+    return r.pokes.empty() ? 0.0 : double(r.pokes[0].newtons.peak);
+  };
+  const double converged = peak(true, 2, 4), warm = peak(true, 1, 1), cold = peak(false, 1, 1);
+  EXPECT_NEAR(warm, converged, 0.05 * converged);
+  EXPECT_GT(cold, 1.5 * converged);
+  testing::record("warm_newtons", warm);
+  testing::record("cold_newtons", cold);
+  testing::record("converged_newtons", converged);
+}
+
 double totalMass(const BodyModel& m) {
   double kg = 0.0;
   for (float w : m.invMass) kg += 1.0 / double(w);

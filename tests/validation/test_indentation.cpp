@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "test_support.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/world.h"
 
@@ -15,19 +16,20 @@ namespace {
 // A 10 x 5 x 10 cm block of 16 x 8 x 16 cells (12,288 tets), E 30 kPa, pinned at its base, no
 // gravity; a 1 cm fingertip (particles, frictionless) comes down 4 mm at its centre in 1.5 s and
 // holds. The mean force over the last half second of the hold.
-double indentationForce(float poisson, int iterations) {
+double indentationForce(float poisson, int iterations, bool warmStart = false, int cells = 16) {
   SolverSettings s;
   s.timeStages = false;
   s.measureResiduals = false;
   s.substeps = 8;
   s.iterations = iterations;
+  s.warmStart = warmStart;
   s.gravity.setZero();
   s.linearDamping = 0.0f;
   World w(s);
   Material m;
   m.elastic = ElasticModuli{3e4f, poisson, 1060.0f, 0.0f};
   const float side = 0.1f, height = 0.05f;
-  const TetMesh mesh = makeBoxTets(Vec3(-side / 2, 0, -side / 2), Vec3(side, height, side), 16, 8, 16);
+  const TetMesh mesh = makeBoxTets(Vec3(-side / 2, 0, -side / 2), Vec3(side, height, side), cells, cells / 2, cells);
   const BodyId block = w.addBody(makeSoftBody(mesh, m));
   for (Index i = 0; i < mesh.vertices.size(); ++i)
     if (mesh.vertices[i].y() < 1e-6f) w.setInverseMass(w.particleIndex(block, i), 0.0f);
@@ -58,6 +60,20 @@ TEST(Indentation, AConvergedPokeMeetsHertz) {
     const double expected = hertz(poisson);  // 1.11 N, 1.27 N
     EXPECT_NEAR(indentationForce(poisson, 40), expected, 0.15 * expected) << "nu " << poisson;
   }
+}
+
+// The same poke with a warm start (SolverSettings::warmStart): the held block is a fixed point of
+// the solve whatever the number of iterations, so 5 iterations hold the force that 80 do; cold, 5
+// iterations leave the block too soft (a coarser block, 8 x 4 x 8 cells, to keep it quick).
+TEST(Indentation, AWarmStartedHoldIsConvergedAtFiveIterations) {
+  const double converged = indentationForce(0.45f, 80, false, 8);
+  const double warm5 = indentationForce(0.45f, 5, true, 8), warm40 = indentationForce(0.45f, 40, true, 8);
+  const double cold5 = indentationForce(0.45f, 5, false, 8);
+  EXPECT_NEAR(warm5, warm40, 1e-3 * warm40);
+  EXPECT_NEAR(warm5, converged, 0.03 * converged);
+  EXPECT_LT(cold5, 0.9 * converged);  // what the warm start is for
+  testing::record("warm5_over_converged", warm5 / converged);
+  testing::record("cold5_over_converged", cold5 / converged);
 }
 
 }  // namespace

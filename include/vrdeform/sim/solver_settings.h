@@ -66,6 +66,14 @@ struct SolverSettings {
   /// more than `tolerance` (relative to its body's mean rest edge) in an iteration, at most
   /// `iterations` times; the step reports how many it ran. 0: always `iterations`.
   float tolerance = 0.0f;
+  /// Starts each substep's solve from the last substep's multipliers instead of from zero
+  /// (Algorithm 1, line 9): the bodies' and the contacts found again keep theirs, and each
+  /// prediction moves by w grad C^T lambda of them first. A body at rest, or held still by a
+  /// fingertip, is then a fixed point of any number of iterations, so its multipliers and the
+  /// forces read from them (lambda / h^2) are the converged ones. Not for bodies whose substep is
+  /// stiff for their mass (hard or nearly incompressible constraints on light particles, cloth):
+  /// the solve can diverge there (docs/haptics.md). false: the paper's cold start.
+  bool warmStart = false;
 
   float substepSize() const { return float(timeStep / substeps); }
 };

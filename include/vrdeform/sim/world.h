@@ -175,6 +175,8 @@ class World {
                               std::vector<FingertipContact>& fingertipContacts) const;
   void detectTriangleContacts();
   void resetMultipliers(const SolverTeam& team);
+  void coldStart(BodyId id);                                             // zeroes the body's multipliers
+  void warmStart(const sweeps::LanePlan& plan, const SolverTeam& team);  // moves the predictions by the multipliers
   void startDeformations(const sweeps::LanePlan& plan, const SolverTeam& team);
   void solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team, bool measure);
   template <typename Sweep>
@@ -199,6 +201,7 @@ class World {
   Particles particles_;                     // the world view, written after each step
   std::vector<Point> local_;                // x: positions in their body's frame at the substep's start
   std::vector<Point> predicted_;            // p: the predictions the constraints correct, in the same frames
+  std::vector<Point> inertial_;             // warm start: the predictions before any constraint moved them
   std::vector<BodyId> particleBody_;        // each particle's body
   std::vector<Collider> frameColliders_;    // colliders in each body's frame: [body * colliders + c]
   std::vector<Fingertip> frameFingertips_;  // fingertips in each body's frame: [body * fingertips + f]
@@ -218,6 +221,10 @@ class World {
   std::vector<float> fingertipTriangleLambda_;
   std::vector<Vec3> fingertipTriangleFrictionLambda_;
   std::vector<std::array<Vec3, 3>> fingertipTriangleImpulse_;  // per corner: sum of grad C dLambda this substep
+  // The last substep's contacts, whose multipliers a warm start carries over.
+  std::vector<ColliderContact> previousColliderContacts_;
+  std::vector<FingertipContact> previousFingertipContacts_;
+  std::vector<FingertipTriangleContact> previousTriangleContacts_;
   std::vector<SimEvent> events_;
   // A team's scratch: each member's contacts before the leader joins them (the leader's own go
   // straight to the lists), and which members found their share of each body finite.
