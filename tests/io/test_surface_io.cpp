@@ -218,7 +218,8 @@ TEST_F(SurfaceIo, MissingEmptyAndGarbageFilesAreErrors) {
   expectError(writeBytes("empty.stl", ""), "empty");
   expectError(writeBytes("words.obj", "hello world\nthis is not a mesh\n"), "");
   expectError(writeBytes("nan.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "non-finite");
-  expectError(writeBytes("inf.off", "OFF\n3 1 0\n0 0 0\n1e39 0 0\n0 1 0\n3 0 1 2\n"), "inf.off:4: vertex coordinate 1e39 is out of range");
+  expectError(writeBytes("inf.off", "OFF\n3 1 0\n0 0 0\n1e39 0 0\n0 1 0\n3 0 1 2\n"),
+              "inf.off:4: vertex coordinate 1e39 is out of range");
   expectError(writeBytes("points.off", "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n"), "");
   expectError(writeBytes("bad.xyz", "v 0 0 0\n"), "");
 
