@@ -298,6 +298,7 @@ void World::step() {
   report_.step = stepCount_;
   residualCount_.fill(0);
   ingest();
+  warm_ = settings_.warmStart;
   // A team pays only for a body big enough to be cut in groups (body_model.cpp): a smaller array is
   // swept by one member anyway, and the others would only wait at its barriers.
   const bool cut = std::any_of(bodies_.begin(), bodies_.end(), [](const Body& b) {
@@ -429,8 +430,8 @@ void World::substeps(const SolverTeam& team) {
       frameFingertips(double(s) / n, double(s + 1) / n);
     }
     predict(h, team);
-    team.barrier();                                  // detection reads the fingertips' new centres
-    if (settings_.warmStart) warmStart(plan, team);  // before detection, which sees where it puts them
+    team.barrier();                    // detection reads the fingertips' new centres
+    if (warm_) warmStart(plan, team);  // before detection, which sees where it puts them
     detectContacts(team);
     startDeformations(plan, team);  // its closing barrier also closes detection
     // Iterations: all of them, or (adaptive) until the largest correction is within the tolerance.
@@ -467,7 +468,7 @@ std::pair<Index, Index> World::particlesOf(const Body& b, const SolverTeam& team
 void World::predict(float h, const SolverTeam& team) {
   StageTimer timer(report_.times, Stage::Predict, settings_.timeStages && team.leader());
   const float keep = std::max(0.0f, 1.0f - settings_.linearDamping * h);
-  const bool warm = settings_.warmStart;
+  const bool warm = warm_;
   for (const Body& b : bodies_) {
     if (b.state != BodyState::Active) continue;
     for (auto [i, end] = particlesOf(b, team); i < end; ++i) {
@@ -490,7 +491,7 @@ void World::detectContacts(const SolverTeam& team) {
   MemberContacts* const own = team.leader() ? nullptr : &memberContacts_[std::size_t(team.index)];
   std::vector<ColliderContact>& collider = own ? own->collider : colliderContacts_;
   std::vector<FingertipContact>& fingertip = own ? own->fingertip : fingertipContacts_;
-  if (settings_.warmStart && team.leader()) {  // kept to carry their multipliers over (resetMultipliers)
+  if (warm_ && team.leader()) {  // kept to carry their multipliers over (resetMultipliers)
     previousColliderContacts_.swap(colliderContacts_);
     previousFingertipContacts_.swap(fingertipContacts_);
     previousTriangleContacts_.swap(fingertipTriangleContacts_);
@@ -608,16 +609,30 @@ void carry(std::vector<T>& lambdas, const std::vector<std::size_t>& from, const 
 
 }  // namespace
 
+// Whether the warm start moved every particle by at most a quarter of its body's mean rest edge. A
+// light particle carrying a large force (a body hanging from one held corner, a light, nearly
+// incompressible body on a coarse substep, a body thrown about) is moved farther by its forces'
+// w h^2 f, and Gauss-Seidel from there can diverge: such a substep starts cold.
+bool World::warmPushesFit() const {
+  for (const Body& b : bodies_) {
+    if (b.state != BodyState::Active) continue;
+    const float limit2 = 0.0625f * b.lengthScale * b.lengthScale;
+    for (Index i = b.firstParticle; i < b.firstParticle + b.particleCount; ++i)
+      if ((predicted_[i].pos - inertial_[i].pos).squaredNorm() > limit2) return false;
+  }
+  return true;
+}
+
 // The bodies' multipliers by the team; the contacts' and attachments' (once detected) by the leader.
 // With a warm start, a contact found again keeps its multipliers and pushes its particles as it did
 // in the last substep, so that the pushes balance the bodies' (warmStart): a fingertip held still
 // against a body at rest leaves it where it was, whatever the number of iterations.
 void World::resetMultipliers(const SolverTeam& team) {
-  if (!settings_.warmStart)
+  if (!warm_)
     for (Body& b : bodies_) clearMultipliers(b, team);
 
   if (!team.leader()) return;
-  if (settings_.warmStart) {
+  if (warm_) {
     // Each push along the contact's direction at the inertial predictions, where the bodies' warm
     // start takes its gradients: at rest, the two cancel.
     Point* const pred = predicted_.data();
@@ -668,7 +683,13 @@ void World::resetMultipliers(const SolverTeam& team) {
         pred[con.i[k]].pos += pred[con.i[k]].w * fingertipTriangleImpulse_[c][k];
       }
     }
-    return;
+    if (warmPushesFit()) return;
+    // Too far for a guess: this substep starts cold, from the inertial predictions.
+    for (Body& b : bodies_) {
+      if (b.state != BodyState::Active) continue;
+      std::copy_n(inertial_.begin() + b.firstParticle, b.particleCount, predicted_.begin() + b.firstParticle);
+      clearMultipliers(b);
+    }
   }
   std::fill(attachmentLambda_.begin(), attachmentLambda_.end(), Vec3::Zero());
   contactNormalLambda_.assign(colliderContacts_.size(), 0.0f);

@@ -250,5 +250,31 @@ TEST(Robustness, SliverSlabRestsStill) {
   EXPECT_TRUE(world.takeEvents().empty());
 }
 
+// A warm-started body held by a compliant attachment whose target jumps a metre in one step (a
+// hand that loses tracking): the step starts cold (World::jumps), as a cold solve would, and the
+// body follows without a non-finite value; warm, the last substep's pull re-applied each substep
+// threw it apart.
+TEST(Robustness, AWarmStartedHoldSurvivesAJump) {
+  SolverSettings s;
+  s.substeps = 8;
+  s.warmStart = true;
+  World world(s);
+  world.addCollider(Collider::plane(Vec3::UnitY()));
+  Material m;
+  m.elastic = ElasticModuli{3e4f, 0.45f, 1060.0f, 0.005f};
+  const BodyId block =
+      world.addBody(makeSoftBody(makeBoxTets(Vec3(-0.05f, 0, -0.05f), Vec3(0.1f, 0.05f, 0.1f), 4, 2, 4), m));
+  const Index held = world.particleIndex(block, world.body(block).particleCount - 1);  // a top corner
+  const Vec3 at = world.particles().x[held].pos;
+  const AttachmentId hold = world.attach(held, at, 1e-5f);
+  for (int k = 0; k < 30; ++k) world.step();
+  world.moveAttachment(hold, at + Vec3(0, 1, 0));
+  for (int k = 0; k < 120; ++k) world.step();
+  EXPECT_TRUE(world.takeEvents().empty());
+  for (const Point& p : world.particles().x) ASSERT_TRUE(isFinite(p.pos));
+  EXPECT_NEAR(world.particles().x[held].pos.y(), at.y() + 1.0f, 0.05f);  // hanging from it
+  EXPECT_LT(std::abs(world.volumeLoss(block)), 0.05);
+}
+
 }  // namespace
 }  // namespace vrd

@@ -177,6 +177,7 @@ class World {
   void resetMultipliers(const SolverTeam& team);
   void coldStart(BodyId id);                                             // zeroes the body's multipliers
   void warmStart(const sweeps::LanePlan& plan, const SolverTeam& team);  // moves the predictions by the multipliers
+  bool warmPushesFit() const;  // the warm start moved no particle too far to be a guess
   void startDeformations(const sweeps::LanePlan& plan, const SolverTeam& team);
   void solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team, bool measure);
   template <typename Sweep>
@@ -244,6 +245,7 @@ class World {
   std::vector<Vec3> residualStart_;
   std::array<double, kStageCount> residualSumSq_{}, residualMax_{};
   std::array<std::size_t, kStageCount> residualCount_{};
+  bool warm_ = false;       // this step's substeps start warm (SolverSettings::warmStart)
   bool converged_ = false;  // set by the leader in an adaptive iteration, read by all after a barrier
   // The solver's threads, made at the first step that uses them; a copy of the world makes its own.
   struct TeamSlot {
