@@ -99,7 +99,13 @@ void printSummary(const RunSummary& r, const BuiltScene& scene) {
   for (std::size_t s = 0; s < kStageCount; ++s)
     if (std::isfinite(r.residuals[s].max))
       fmt::print(" {} {:.1e} {:.1e};", stageName(Stage(s)), r.residuals[s].rms, r.residuals[s].max);
-  fmt::print("\n  NaN events: {}\n", r.nanEvents);
+  fmt::print("\n");
+  if (r.coldSubstepShare >= 0.001)
+    fmt::print(
+        "  warm start: {:.1f}% of the substeps started cold (their warm start would have moved a particle over a "
+        "quarter of its body's mean rest edge){}\n",
+        100 * r.coldSubstepShare, r.coldSubstepShare > 0.02 ? ": give the scene more substeps" : "");
+  fmt::print("  NaN events: {}\n", r.nanEvents);
   for (const std::string& e : r.events) fmt::print("    {}\n", e);
   const auto mean = [&](Stage s) { return r.latency.stage(s, Phase::All).mean; };
   const double tv = mean(Stage::Volume), ts = mean(Stage::Strain), tm = mean(Stage::ShapeMatching);

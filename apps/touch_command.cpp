@@ -1,6 +1,7 @@
 #include "touch_command.h"
 
 #include <fmt/format.h>
+#include <fmt/ostream.h>
 
 #include <algorithm>
 #include <array>
@@ -11,6 +12,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -20,7 +22,7 @@
 #include <vector>
 
 #include "glove_link.h"
-#include "vrdeform/core/write_file.h"
+#include "vrdeform/core/atomic_file.h"
 #include "vrdeform/devices/csv_recorder.h"
 #include "vrdeform/devices/osc_output.h"
 #include "vrdeform/devices/stop_signals.h"
@@ -313,26 +315,28 @@ struct Tally {
 };
 
 // Runs `input` through the session step by step (up to maxSteps), printing the timeline and
-// collecting the CSV. `afterStep(k)` returns false to stop.
+// writing the recording and the CSV as it goes. `afterStep(k)` returns false to stop.
 template <typename AfterStep>
 Tally drive(HapticSession& session, HandInput& input, std::uint64_t maxSteps, double reportEvery,
-            SessionRecording* record, std::string* csv, AfterStep afterStep) {
+            SessionRecordingWriter* record, std::ostream* csv, AfterStep afterStep) {
   const HandRig& rig = session.rig();
   const double dt = session.world().settings().timeStep;
   const std::uint64_t every = steps(reportEvery, dt);
   if (csv) {
-    *csv = "t,paper,paper_raw";
+    *csv << "t,paper,paper_raw";
     for (int f = 0; f < kFingerCount; ++f)
-      if (rig.has(Finger(f))) *csv += fmt::format(",{0}_force,{0}_raw,{0}_newtons,{0}_baseline", kFingerNames[f]);
-    *csv += ",grasp\n";
+      if (rig.has(Finger(f))) fmt::print(*csv, ",{0}_force,{0}_raw,{0}_newtons,{0}_baseline", kFingerNames[f]);
+    *csv << ",grasp\n";
   }
+  std::function<void(const RecordedStep&)> recordStep;
+  if (record) recordStep = [record](const RecordedStep& step) { record->add(step); };
   fmt::print("\n{:>7} {:>7} {:>9} {:>7} {:>8} {:>8} {:>5}\n", "t (s)", "index", "index (N)", "paper", "baseline",
              "contacts", "grasp");
   Tally tally;
   const auto start = std::chrono::steady_clock::now();
   std::optional<HapticFrame> last;
   while (tally.steps < maxSteps) {
-    if (session.run(input, 1, record) == 0) break;
+    if (session.run(input, 1, recordStep) == 0) break;
     const std::uint64_t k = tally.steps++;
     const HapticFrame& f = session.haptics();
     const double t = double(k + 1) * dt;
@@ -346,12 +350,12 @@ Tally drive(HapticSession& session, HandInput& input, std::uint64_t maxSteps, do
     }
     for (const SimEvent& e : session.world().takeEvents()) fmt::print("  event: {}\n", e.message);
     if (csv) {
-      *csv += fmt::format("{:.6f},{},{}", t, f.paper, f.paperRaw);
+      fmt::print(*csv, "{:.6f},{},{}", t, f.paper, f.paperRaw);
       for (int i = 0; i < kFingerCount; ++i)
         if (rig.has(Finger(i)))
-          *csv += fmt::format(",{},{},{},{}", f.fingers[i].force, f.fingers[i].raw, f.fingers[i].newtons,
-                              f.fingers[i].baseline);
-      *csv += session.grasp().active() ? ",1\n" : ",0\n";
+          fmt::print(*csv, ",{},{},{},{}", f.fingers[i].force, f.fingers[i].raw, f.fingers[i].newtons,
+                     f.fingers[i].baseline);
+      *csv << (session.grasp().active() ? ",1\n" : ",0\n");
     }
     const bool go = afterStep(k);
     const bool lastStep = !go || tally.steps == maxSteps || input.finished(k + 1, double(k + 1) * dt);
@@ -456,12 +460,11 @@ int touch(const TouchArgs& a, const std::string& version) {
         1e3f * settings.hand.geometry.fingertipRadius, kPokeDown, kPokeHold, kPokeUp);
   }
 
-  std::optional<SessionRecording> recording;
-  if (!a.record.empty()) {
-    recording.emplace();
-    recording->settings = recordedSettings(s, tau, body.hash, version, inputName);
-    (void)recording->format();  // refuses settings that would not read back (e.g. a non-ASCII path) now, not later
-  }
+  // Written as the session runs, into place when it ends (a session of any length holds none of it).
+  std::optional<SessionRecordingWriter> recording;
+  if (!a.record.empty()) recording.emplace(a.record, recordedSettings(s, tau, body.hash, version, inputName));
+  std::optional<AtomicFile> csv;
+  if (!a.csv.empty()) csv.emplace(a.csv);
 
   HapticSession session(*body.world, settings, input->frame(0, 0.0));
   // Other outputs of the same signal: a timestamped force log and OSC over UDP (docs/outputs.md).
@@ -471,7 +474,6 @@ int touch(const TouchArgs& a, const std::string& version) {
     const HostPort to = parseHostPort(a.osc);
     outputs.push_back(std::make_unique<OscOutput>(to.host, to.port));
   }
-  std::string csv;
   const StopSignals signals;
   const auto afterStep = [&](std::uint64_t k) {
     const HapticSample sample = sampleOf(double(k + 1) / s.rate, session.haptics(), settings.hand.fingers);
@@ -482,17 +484,17 @@ int touch(const TouchArgs& a, const std::string& version) {
   const std::uint64_t cap =
       glove && a.seconds <= 0.0 ? std::numeric_limits<std::uint64_t>::max() : stepCap(a.seconds, s.rate);
   const Tally tally = drive(session, *input, cap, a.reportEvery, recording ? &*recording : nullptr,
-                            a.csv.empty() ? nullptr : &csv, afterStep);
+                            csv ? &csv->stream() : nullptr, afterStep);
   if (glove) glove->shutdown();  // release the glove before anything that could throw below
   for (const auto& out : outputs) out->release();
   printSummary(tally, session.rig(), 1.0 / s.rate);
-  if (!a.csv.empty()) {
-    writeFile(a.csv, csv);
+  if (csv) {
+    csv->commit();
     fmt::print("wrote {}\n", a.csv);
   }
   if (recording) {
-    recording->save(a.record);
-    fmt::print("recorded {} steps to {}\n", recording->steps.size(), a.record);
+    recording->finish();
+    fmt::print("recorded {} steps to {}\n", recording->steps(), a.record);
   }
   return 0;
 }
@@ -557,9 +559,11 @@ int replay(const TouchArgs& a, const std::string& version, bool sceneOptionsGive
   RecordingInput input(std::move(recording));
   const std::vector<RecordedStep>& steps = input.recording().steps;
   HapticSession session(*body.world, settings, input.frame(0, 0.0));
-  std::string csv, difference;
+  std::optional<AtomicFile> csv;
+  if (!a.csv.empty()) csv.emplace(a.csv);
+  std::string difference;
   const Tally tally = drive(session, input, stepCap(a.seconds, s.rate), a.reportEvery, nullptr,
-                            a.csv.empty() ? nullptr : &csv, [&](std::uint64_t k) {
+                            csv ? &csv->stream() : nullptr, [&](std::uint64_t k) {
                               const std::vector<float> now = recordedOutputs(session.haptics());
                               const std::vector<float>& then = steps[k].outputs;
                               if (now.size() != then.size()) {
@@ -578,8 +582,8 @@ int replay(const TouchArgs& a, const std::string& version, bool sceneOptionsGive
                               return true;
                             });
   printSummary(tally, session.rig(), 1.0 / s.rate);
-  if (!a.csv.empty()) {
-    writeFile(a.csv, csv);
+  if (csv) {
+    csv->commit();
     fmt::print("wrote {}\n", a.csv);
   }
   if (!difference.empty()) {

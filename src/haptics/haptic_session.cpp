@@ -25,14 +25,15 @@ const HapticFrame& HapticSession::step(const HandFrame& input) {
   return haptics_.frame();
 }
 
-std::uint64_t HapticSession::run(HandInput& input, std::uint64_t maxSteps, SessionRecording* record) {
+std::uint64_t HapticSession::run(HandInput& input, std::uint64_t maxSteps,
+                                 const std::function<void(const RecordedStep&)>& record) {
   std::uint64_t done = 0;
   for (; done < maxSteps; ++done) {
     const double time = double(steps_) * world_.settings().timeStep;
     if (input.finished(steps_, time)) break;
     const HandFrame frame = input.frame(steps_, time);
     step(frame);
-    if (record) record->steps.push_back({frame, recordedOutputs(haptics())});
+    if (record) record({frame, recordedOutputs(haptics())});
   }
   return done;
 }

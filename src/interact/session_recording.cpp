@@ -139,8 +139,10 @@ const std::string* SessionRecording::setting(std::string_view key) const {
   return nullptr;
 }
 
-std::string SessionRecording::format() const {
-  std::string out = fmt::format("{} {}\n", kTag, kVersion);
+namespace {
+
+void appendHeader(std::string& out, const std::vector<std::pair<std::string, std::string>>& settings) {
+  fmt::format_to(std::back_inserter(out), "{} {}\n", kTag, kVersion);
   for (std::size_t i = 0; i < settings.size(); ++i) {
     const auto& [key, value] = settings[i];
     const std::string what = settingProblem(key, value);
@@ -150,24 +152,61 @@ std::string SessionRecording::format() const {
     fmt::format_to(std::back_inserter(out), "{} {}{}{}\n", kSetting, key, value.empty() ? "" : " ", value);
   }
   fmt::format_to(std::back_inserter(out), "# {}\n", kLayout);
-  for (std::size_t k = 0; k < steps.size(); ++k) {
-    const HandFrame& f = steps[k].frame;
-    fmt::format_to(std::back_inserter(out), "{} {}", k, f.direct ? 1 : 0);
-    auto put = [&](float v) {
-      out += ' ';
-      appendFloat(out, v);
-    };
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 4; ++c) put(f.pose.wrist.matrix()(r, c));
-    for (float c : f.pose.closure) put(c);
-    for (const Vec3& tip : f.fingertips)
-      for (int a = 0; a < 3; ++a) put(tip[a]);
-    fmt::format_to(std::back_inserter(out), " {}", steps[k].outputs.size());
-    for (float v : steps[k].outputs) put(v);
-    out += '\n';
-  }
-  fmt::format_to(std::back_inserter(out), "{} {}\n", kEnd, steps.size());
+}
+
+void appendStep(std::string& out, std::uint64_t k, const RecordedStep& step) {
+  const HandFrame& f = step.frame;
+  fmt::format_to(std::back_inserter(out), "{} {}", k, f.direct ? 1 : 0);
+  auto put = [&](float v) {
+    out += ' ';
+    appendFloat(out, v);
+  };
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) put(f.pose.wrist.matrix()(r, c));
+  for (float c : f.pose.closure) put(c);
+  for (const Vec3& tip : f.fingertips)
+    for (int a = 0; a < 3; ++a) put(tip[a]);
+  fmt::format_to(std::back_inserter(out), " {}", step.outputs.size());
+  for (float v : step.outputs) put(v);
+  out += '\n';
+}
+
+void appendEnd(std::string& out, std::uint64_t steps) {
+  fmt::format_to(std::back_inserter(out), "{} {}\n", kEnd, steps);
+}
+
+std::string header(const std::vector<std::pair<std::string, std::string>>& settings) {
+  std::string out;
+  appendHeader(out, settings);
   return out;
+}
+
+}  // namespace
+
+std::string SessionRecording::format() const {
+  std::string out = header(settings);
+  for (std::size_t k = 0; k < steps.size(); ++k) appendStep(out, k, steps[k]);
+  appendEnd(out, steps.size());
+  return out;
+}
+
+SessionRecordingWriter::SessionRecordingWriter(const std::filesystem::path& path,
+                                               const std::vector<std::pair<std::string, std::string>>& settings)
+    : text_(header(settings)), file_(path) {
+  file_.stream() << text_;
+}
+
+void SessionRecordingWriter::add(const RecordedStep& step) {
+  text_.clear();
+  appendStep(text_, steps_++, step);
+  file_.stream() << text_;
+}
+
+void SessionRecordingWriter::finish() {
+  text_.clear();
+  appendEnd(text_, steps_);
+  file_.stream() << text_;
+  file_.commit();
 }
 
 void SessionRecording::save(const std::filesystem::path& path) const {

@@ -227,7 +227,7 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
   Traces traces;
   std::array<double, kStageCount> residualRmsSum{};
   std::array<std::size_t, kStageCount> residualSteps{};
-  double iterations = 0.0;
+  double iterations = 0.0, coldSubsteps = 0.0;
   // The scripted pokes by start (they do not overlap); those before firstOpen are done.
   std::vector<PokeTrace> pokes;
   for (const HandAction& a : scene.actions)
@@ -257,6 +257,7 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
       }
       const StageTimes& times = session ? session->times() : world.lastStep().times;
       iterations += world.lastStep().iterations;
+      coldSubsteps += world.lastStep().coldSubsteps;
       for (std::size_t s = 0; s < kStageCount; ++s)
         if (const Residual& r = world.lastStep().residuals[s]; std::isfinite(r.max)) {
           residualRmsSum[s] += r.rms;
@@ -314,7 +315,10 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
   for (HapticOutput* out : settings.outputs) out->release();
   for (std::size_t s = 0; s < kStageCount; ++s)
     if (residualSteps[s] > 0) summary.residuals[s].rms = residualRmsSum[s] / double(residualSteps[s]);
-  if (summary.steps > 0) summary.iterationsMean = iterations / double(summary.steps);
+  if (summary.steps > 0) {
+    summary.iterationsMean = iterations / double(summary.steps);
+    summary.coldSubstepShare = coldSubsteps / (double(summary.steps) * scene.spec.solver.substeps);
+  }
   summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (files && summary.ok) {
     try {
@@ -379,6 +383,7 @@ std::string summaryJson(const RunSummary& s) {
                                                      {"max", number(s.residuals[k].max)}};
   j["residuals"] = residuals;
   j["iterations_mean"] = number(s.iterationsMean);
+  j["cold_substep_share"] = number(s.coldSubstepShare);
   json stages = json::object();
   const auto stats = [&](const SampleStats& st) {
     return json{{"mean", number(st.mean)}, {"p50", number(st.median)}, {"p95", number(st.p95)},

@@ -685,6 +685,7 @@ void World::resetMultipliers(const SolverTeam& team) {
     }
     if (warmPushesFit()) return;
     // Too far for a guess: this substep starts cold, from the inertial predictions.
+    ++report_.coldSubsteps;
     for (Body& b : bodies_) {
       if (b.state != BodyState::Active) continue;
       std::copy_n(inertial_.begin() + b.firstParticle, b.particleCount, predicted_.begin() + b.firstParticle);

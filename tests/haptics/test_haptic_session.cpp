@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <numeric>
 #include <vector>
 
@@ -322,16 +324,24 @@ TEST(HapticSession, RecordedSessionReplaysBitForBit) {
   recording.settings = {{"scene", "liver"}};
   std::vector<Point> finalPositions;
   bool felt = false;
+  const std::filesystem::path written = testing::scratchPath("written.session");
   {
     Liver liver;
     HapticSession session(liver.world, s, script.frame(0, 0.0));
-    const std::uint64_t steps = session.run(script, 1000, &recording);  // 0 .. 1.5 s at 60 Hz
-    EXPECT_TRUE(steps == 90u || steps == 91u) << steps;                 // the last one, at 1.5 s, is rounding
+    SessionRecordingWriter writer(written, recording.settings);  // the same, written as it goes
+    const std::uint64_t steps = session.run(script, 1000, [&](const RecordedStep& step) {
+      recording.steps.push_back(step);
+      writer.add(step);
+    });  // 0 .. 1.5 s at 60 Hz
+    writer.finish();
+    EXPECT_TRUE(steps == 90u || steps == 91u) << steps;  // the last one, at 1.5 s, is rounding
     finalPositions = liver.world.particles().x;
     for (const RecordedStep& r : recording.steps)
       for (float v : r.outputs) felt |= v > 0.0f;
   }
   ASSERT_TRUE(felt);  // the hand did touch the body
+  std::ifstream in(written, std::ios::binary);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), recording.format());
 
   const std::filesystem::path file = testing::scratchPath("replay.session");
   recording.save(file);
@@ -339,7 +349,8 @@ TEST(HapticSession, RecordedSessionReplaysBitForBit) {
   Liver liver;
   HapticSession session(liver.world, s, replay.frame(0, 0.0));
   SessionRecording again;
-  EXPECT_EQ(session.run(replay, 1000, &again), recording.steps.size());
+  EXPECT_EQ(session.run(replay, 1000, [&](const RecordedStep& step) { again.steps.push_back(step); }),
+            recording.steps.size());
   for (std::size_t k = 0; k < recording.steps.size(); ++k) {
     const auto& a = recording.steps[k].outputs;
     const auto& b = again.steps[k].outputs;

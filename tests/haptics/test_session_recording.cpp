@@ -185,6 +185,7 @@ TEST(SessionRecording, SettingsThatWouldNotReadBackAreRefusedAndLeaveTheFileAlon
     SessionRecording r = good;
     r.settings.push_back(setting);
     EXPECT_NE(errorOf([&] { r.save(path); }).find("setting"), std::string::npos) << setting.first;
+    EXPECT_NE(errorOf([&] { SessionRecordingWriter(path, r.settings); }).find("setting"), std::string::npos);
   }
   SessionRecording twice = good;
   twice.settings.push_back({"scene", "other"});

@@ -3,6 +3,7 @@
 // force. Single-threaded and deterministic: the same world and inputs give the same bits.
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "vrdeform/haptics/haptic_model.h"
@@ -28,8 +29,10 @@ class HapticSession {
   /// computes the haptic outputs.
   const HapticFrame& step(const HandFrame& input);
   /// Steps through `input` (step k at time k dt from this session's first step) until it is
-  /// finished or `maxSteps` have run; appends each step to `record` when given. Returns the steps run.
-  std::uint64_t run(HandInput& input, std::uint64_t maxSteps, SessionRecording* record = nullptr);
+  /// finished or `maxSteps` have run; hands each step to `record` when given (to keep in a
+  /// SessionRecording, or to write with a SessionRecordingWriter). Returns the steps run.
+  std::uint64_t run(HandInput& input, std::uint64_t maxSteps,
+                    const std::function<void(const RecordedStep&)>& record = {});
 
   World& world() { return world_; }
   const World& world() const { return world_; }

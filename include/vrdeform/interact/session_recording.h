@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "vrdeform/core/atomic_file.h"
 #include "vrdeform/interact/hand_input.h"
 
 namespace vrd {
@@ -38,6 +39,25 @@ struct SessionRecording {
   /// order) throws vrd::Error "sourceName:line: what".
   static SessionRecording parse(std::string_view text, std::string_view sourceName);
   static SessionRecording load(const std::filesystem::path& path);
+};
+
+/// Writes a recording while it is made: the settings at once and each step as it comes, so that a
+/// session of any length keeps none of it in memory; finish() ends it and moves it into place,
+/// complete or not at all (as SessionRecording::save, whose text it writes).
+class SessionRecordingWriter {
+ public:
+  /// Throws vrd::Error for a setting that could not be read back, before the file is touched.
+  SessionRecordingWriter(const std::filesystem::path& path,
+                         const std::vector<std::pair<std::string, std::string>>& settings);
+  void add(const RecordedStep& step);
+  /// Throws vrd::Error when a write failed.
+  void finish();
+  std::uint64_t steps() const { return steps_; }
+
+ private:
+  std::string text_;  // the header first, then each step's line before it is written
+  AtomicFile file_;
+  std::uint64_t steps_ = 0;
 };
 
 /// Replays a recording by step number (time is ignored): step k gets steps[k].frame, bit for bit.

@@ -61,7 +61,10 @@ struct RunSummary {
   /// How converged the steps were, per constraint stage (StepReport::residuals): the mean of the
   /// steps' RMS and the largest max; NaN for stages not measured.
   std::array<Residual, kStageCount> residuals;
-  double iterationsMean = 0.0;      ///< Gauss-Seidel iterations per step
+  double iterationsMean = 0.0;  ///< Gauss-Seidel iterations per step
+  /// With a warm start, the share of substeps that started cold because it would have moved a
+  /// particle too far (World::warmPushesFit): more than a few percent asks for more substeps.
+  double coldSubstepShare = 0.0;
   std::uint64_t nanEvents = 0;      ///< bodies frozen or particles reset after a NaN
   std::vector<std::string> events;  ///< what the first 100 of them were
   LatencyRecorder latency;          ///< per step: idle (no finger touching, no grasp) or contact

@@ -51,7 +51,8 @@ struct StepReport {
   /// for every world constraint: attachments, collider and fingertip contacts), with
   /// SolverSettings::measureResiduals or a tolerance.
   std::array<Residual, kStageCount> residuals;
-  int iterations = 0;                 ///< Gauss-Seidel iterations run, summed over the substeps
+  int iterations = 0;    ///< Gauss-Seidel iterations run, summed over the substeps
+  int coldSubsteps = 0;  ///< with SolverSettings::warmStart: substeps whose warm start moved too far, started cold
   std::size_t colliderContacts = 0;   ///< contacts that pushed (lambda > 0) in the last substep
   std::size_t fingertipContacts = 0;  ///< fingertip contacts (particles and triangles) that pushed in the last substep
 };
