@@ -50,6 +50,18 @@ std::string printable(std::string_view text) {
   return out;
 }
 
+void splitWords(std::string_view line, std::vector<std::string_view>& words) {
+  const auto blank = [](char c) { return c != '\n' && isSpace(c); };
+  words.clear();
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && blank(line[i])) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && !blank(line[i])) ++i;
+    if (i > start) words.push_back(line.substr(start, i - start));
+  }
+}
+
 bool parseInteger(std::string_view token, std::int64_t& value) {
   if (!token.empty() && token.front() == '+') token.remove_prefix(1);
   const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);

@@ -20,19 +20,6 @@ constexpr const char* kField[] = {"time", "x",     "y",     "z",      "qw",   "q
                                   "qz",   "thumb", "index", "middle", "ring", "little"};
 constexpr const char* kLayout = "time  x y z  qw qx qy qz  thumb index middle [ring little]";
 
-std::vector<std::string_view> split(std::string_view line) {
-  std::vector<std::string_view> tokens;
-  std::size_t i = 0;
-  auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; };
-  while (i < line.size()) {
-    while (i < line.size() && space(line[i])) ++i;
-    const std::size_t start = i;
-    while (i < line.size() && !space(line[i])) ++i;
-    if (i > start) tokens.push_back(line.substr(start, i - start));
-  }
-  return tokens;
-}
-
 // Straight to float (correctly rounded), so that a float written shortest reads back to its bits;
 // through a double only when out of float range (overflow becomes infinity, rejected later).
 bool parseFloat(std::string_view token, float& value) {
@@ -132,7 +119,8 @@ HandScript HandScript::parse(std::string_view text, std::string_view sourceName)
   while (!lines.atEnd()) {  // skips blank lines and comments
     std::string_view line = lines.restOfLine();
     line = line.substr(0, line.find('#'));
-    const std::vector<std::string_view> tokens = split(line);
+    std::vector<std::string_view> tokens;
+    io::splitWords(line, tokens);
     if (tokens.empty()) continue;  // cannot happen after atEnd(), but costs nothing to be sure
     if (tokens.front() == kTag) {
       if (!first) lines.fail(fmt::format("'{}' (the format tag) may only be the first line", kTag));

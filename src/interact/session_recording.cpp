@@ -27,17 +27,6 @@ constexpr const char* kLayout =
 
 bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
-void split(std::string_view line, std::vector<std::string_view>& tokens) {
-  tokens.clear();
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && isSpace(line[i])) ++i;
-    const std::size_t start = i;
-    while (i < line.size() && !isSpace(line[i])) ++i;
-    if (i > start) tokens.push_back(line.substr(start, i - start));
-  }
-}
-
 // Hexadecimal floats (C's %a): exact in both directions. Infinities are written "inf"/"-inf", NaN
 // "nan"/"-nan" (sign kept, payload not).
 void appendFloat(std::string& out, float v) {
@@ -224,7 +213,7 @@ SessionRecording SessionRecording::parse(std::string_view text, std::string_view
   bool tagged = false, ended = false;
   while (!lines.atEnd()) {  // skips blank lines and comment lines
     const std::string_view line = lines.restOfLine();
-    split(line, tokens);
+    io::splitWords(line, tokens);
     if (tokens.empty()) continue;  // cannot happen after atEnd(), but costs nothing to be sure
     if (!tagged) {
       std::int64_t version = 0;

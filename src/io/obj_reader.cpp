@@ -10,19 +10,10 @@
 namespace vrd {
 namespace {
 
-bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-
-// The whitespace-separated words of one line, up to a comment.
+// The words of one line, up to a comment.
 std::vector<std::string_view> words(std::string_view line) {
-  if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
   std::vector<std::string_view> out;
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && isBlank(line[i])) ++i;
-    const std::size_t start = i;
-    while (i < line.size() && !isBlank(line[i])) ++i;
-    if (i > start) out.push_back(line.substr(start, i - start));
-  }
+  io::splitWords(line.substr(0, line.find('#')), out);
   return out;
 }
 

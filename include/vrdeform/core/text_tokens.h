@@ -7,6 +7,7 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 namespace vrd::io {
 
@@ -16,6 +17,9 @@ std::string readFileBytes(const std::filesystem::path& path);
 /// At most 24 characters of `text` for a message, bytes other than printable ASCII shown as \xNN:
 /// what a broken file holds may be binary garbage.
 std::string printable(std::string_view text);
+
+/// The words of one line, separated by spaces, tabs, \r, \v or \f, in order (into `words`, cleared first).
+void splitWords(std::string_view line, std::vector<std::string_view>& words);
 
 /// Parses all of `token` as a decimal integer or a real number (C locale); false when it is not one.
 bool parseInteger(std::string_view token, std::int64_t& value);
