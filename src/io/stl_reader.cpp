@@ -2,8 +2,9 @@
 
 #include <fmt/format.h>
 
-#include <cmath>
-#include <cstring>
+#include <bit>
+#include <cctype>
+#include <cstdint>
 
 #include "io/binary.h"
 #include "vrdeform/core/text_tokens.h"
@@ -75,17 +76,17 @@ TriMesh readAscii(std::string_view text, const std::string& name) {
 }  // namespace
 
 TriMesh readStl(std::string_view bytes, const std::string& name) {
-  if (bytes.size() >= kHeader) {
-    const auto facets = io::loadUnsigned(reinterpret_cast<const unsigned char*>(bytes.data()) + 80, 4, false);
-    if (bytes.size() == kHeader + kFacet * facets) return readBinary(bytes, facets);
-  }
+  // The count a binary header would hold (0 for a file too short to have one).
+  const std::uint64_t facets =
+      bytes.size() < kHeader ? 0
+                             : io::loadUnsigned(reinterpret_cast<const unsigned char*>(bytes.data()) + 80, 4, false);
+  if (bytes.size() >= kHeader && bytes.size() == kHeader + kFacet * facets) return readBinary(bytes, facets);
   std::size_t start = 0;
   while (start < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[start]))) ++start;
   if (bytes.substr(start, 5) == "solid") return readAscii(bytes, name);
   if (bytes.size() < kHeader)
     throw Error(fmt::format("{}: {} bytes: too short for a binary STL (84) and not ASCII STL (no 'solid')", name,
                             bytes.size()));
-  const auto facets = io::loadUnsigned(reinterpret_cast<const unsigned char*>(bytes.data()) + 80, 4, false);
   throw Error(fmt::format("{}: a binary STL of {} facets takes {} bytes, the file has {} (truncated or not STL)", name,
                           facets, kHeader + kFacet * facets, bytes.size()));
 }
