@@ -39,9 +39,11 @@ struct LaneSweeps {
   /// eq. 25's sums over particles [begin, end)
   void (*shapeMatchSums)(const Point* p, const Vec3* restOffsets, const float* mass, std::size_t begin, std::size_t end,
                          ShapeMatchSums& out);
-  /// shape matching's goals (eq. 28) for particles [begin, end)
-  void (*shapeMatch)(const Vec3* restOffsets, float compliance, const ShapeMatchFrame& frame, Vec3* lambda, float tau,
-                     const Range& r, std::size_t begin, std::size_t end);
+  /// shape matching's goals (eq. 28) for particles [begin, end); `start`: the frame at the start of
+  /// the substep (damping)
+  void (*shapeMatch)(const Vec3* restOffsets, float compliance, const ShapeMatchFrame& frame,
+                     const ShapeMatchFrame& start, Vec3* lambda, float tau, const Range& r, std::size_t begin,
+                     std::size_t end);
 };
 
 template <typename T>

@@ -354,26 +354,36 @@ VRD_SWEEP void shapeMatchSumsOf(const Point* p, const Vec3* q, const float* mass
 }
 
 // Shape matching's goals (eq. 28) for particles [begin, end) of offsets q (ShapeMatchModel::
-// restOffsets) and multipliers `lambda`, given the frame (eqs. 25-27): one at a time, or
-// kWidth<T> consecutive particles at once and a last batch padded (as in forBatches), so that
-// every particle gets the same arithmetic in whichever batch and lane it falls.
+// restOffsets) and multipliers `lambda`, given the frame (eqs. 25-27) and, for the damping, the
+// frame at the start of the substep: one at a time, or kWidth<T> consecutive particles at once and
+// a last batch padded (as in forBatches), so that every particle gets the same arithmetic in
+// whichever batch and lane it falls.
 template <typename T>
-VRD_SWEEP void shapeMatchParticles(const Vec3* q, float compliance, const ShapeMatchFrame& frame, Vec3* lambda,
-                                   float tau, const Range& r, std::size_t begin, std::size_t end) {
+VRD_SWEEP void shapeMatchParticles(const Vec3* q, float compliance, const ShapeMatchFrame& frame,
+                                   const ShapeMatchFrame& startFrame, Vec3* lambda, float tau, const Range& r,
+                                   std::size_t begin, std::size_t end) {
   if constexpr (kWidth<T> == 1) {
     const XpbdCoefficients k = XpbdCoefficients::make(compliance, tau, r.invH);
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3 goal = frame.centroid + frame.rotation * q[i];
-      const Vec3 disp = tau > 0.0f ? Vec3(r.pred[i].pos - r.start[i].pos) : Vec3::Zero();
-      const Vec3 dLambda = solveShapeMatchParticle(r.pred[i], goal, lambda[i], k, disp);
+      const Vec3 change =
+          tau > 0.0f
+              ? Vec3((r.pred[i].pos - goal) - (r.start[i].pos - (startFrame.centroid + startFrame.rotation * q[i])))
+              : Vec3::Zero();
+      const Vec3 dLambda = solveShapeMatchParticle(r.pred[i], goal, lambda[i], k, change);
       lambda[i] += dLambda;
       r.pred[i].pos += r.pred[i].w * dLambda;
     }
   } else {
     constexpr std::size_t W = kWidth<T>;
     // No Eigen call here (lane_sweeps.h): R's floats column-major, then c2's.
-    const float* R = reinterpret_cast<const float*>(&frame.rotation);
-    const float* c = reinterpret_cast<const float*>(&frame.centroid);
+    const auto goalsOf = [](const ShapeMatchFrame& f, const V3<T>& off) {
+      const float* R = reinterpret_cast<const float*>(&f.rotation);
+      const float* c = reinterpret_cast<const float*>(&f.centroid);
+      return V3<T>{splat<T>(c[0]) + splat<T>(R[0]) * off.x + splat<T>(R[3]) * off.y + splat<T>(R[6]) * off.z,
+                   splat<T>(c[1]) + splat<T>(R[1]) * off.x + splat<T>(R[4]) * off.y + splat<T>(R[7]) * off.z,
+                   splat<T>(c[2]) + splat<T>(R[2]) * off.x + splat<T>(R[5]) * off.y + splat<T>(R[8]) * off.z};
+    };
     const T alphaTilde = splat<T>(compliance * r.invH * r.invH), gamma = splat<T>(tau * r.invH), zero = splat<T>(0.0);
     // solveShapeMatchParticle for W particles; kinematic ones (w = 0) get no change.
     const auto batch = [&](Point* pred, const Point* start, const Vec3* offsets, Vec3* lambdas, std::size_t count) {
@@ -381,14 +391,12 @@ VRD_SWEEP void shapeMatchParticles(const Vec3* q, float compliance, const ShapeM
       T w, ws;
       loadConsecutivePoints(pred, p, w);
       const V3<T> off = loadVec3s<T>(offsets), lambdaNow = loadVec3s<T>(lambdas);
-      const V3<T> goal = {splat<T>(c[0]) + splat<T>(R[0]) * off.x + splat<T>(R[3]) * off.y + splat<T>(R[6]) * off.z,
-                          splat<T>(c[1]) + splat<T>(R[1]) * off.x + splat<T>(R[4]) * off.y + splat<T>(R[7]) * off.z,
-                          splat<T>(c[2]) + splat<T>(R[2]) * off.x + splat<T>(R[5]) * off.y + splat<T>(R[8]) * off.z};
-      V3<T> disp = V3<T>::Zero();
-      if (tau > 0.0f) loadConsecutivePoints(start, x, ws), disp = p - x;
+      const V3<T> goal = goalsOf(frame, off);
+      V3<T> change = V3<T>::Zero();  // of C = p - goal in the substep
+      if (tau > 0.0f) loadConsecutivePoints(start, x, ws), change = (p - goal) - (x - goalsOf(startFrame, off));
       const T alphaTildeOf = alphaTilde * w;  // alpha_i = alpha / m_i
       const T invDenominator = 1.0f / ((1.0f + gamma) * w + alphaTildeOf);
-      const V3<T> d = (goal - p - alphaTildeOf * lambdaNow - gamma * disp) * invDenominator;
+      const V3<T> d = (goal - p - alphaTildeOf * lambdaNow - gamma * change) * invDenominator;
       const auto moves = w > zero;
       const V3<T> dLambda = {select(moves, d.x, zero), select(moves, d.y, zero), select(moves, d.z, zero)};
       storeVec3s<T>(lambdas, lambdaNow + dLambda);

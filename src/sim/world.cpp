@@ -433,7 +433,7 @@ void World::substeps(const SolverTeam& team) {
     team.barrier();                    // detection reads the fingertips' new centres
     if (warm_) warmStart(plan, team);  // before detection, which sees where it puts them
     detectContacts(team);
-    startDeformations(plan, team);  // its closing barrier also closes detection
+    recordSubstepStart(plan, team);  // its closing barrier also closes detection
     // Iterations: all of them, or (adaptive) until the largest correction is within the tolerance.
     const bool adaptive = settings_.tolerance > 0.0f;
     int it = 0;
@@ -485,7 +485,7 @@ void World::predict(float h, const SolverTeam& team) {
 // team cuts the lists at particle boundaries (solveWorldConstraints). Each member detects its share
 // of the particles into its own lists, and the leader joins them in member order (so in particle
 // order) and finds the triangle contacts; then each member resets its share of the multipliers and
-// goes on to startDeformations, whose barrier closes this.
+// goes on to recordSubstepStart, whose barrier closes this.
 void World::detectContacts(const SolverTeam& team) {
   StageTimer timer(report_.times, Stage::Detect, settings_.timeStages && team.leader());
   MemberContacts* const own = team.leader() ? nullptr : &memberContacts_[std::size_t(team.index)];
@@ -702,11 +702,48 @@ void World::resetMultipliers(const SolverTeam& team) {
   fingertipTriangleImpulse_.assign(fingertipTriangleContacts_.size(), {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
 }
 
-// F of every tet at the start of the substep, for the damped strain sweeps: each member a share.
-void World::startDeformations(const sweeps::LanePlan& plan, const SolverTeam& team) {
+namespace {
+
+// Shape matching cuts a body's n particles into `runs` runs (one ShapeMatchSums each), run k from
+// n k / runs; each member of the team takes consecutive runs: these.
+std::pair<std::size_t, std::size_t> shapeMatchRuns(std::size_t runs, const SolverTeam& team) {
+  return {runs * std::size_t(team.index) / std::size_t(team.size),
+          runs * std::size_t(team.index + 1) / std::size_t(team.size)};
+}
+
+// Eqs. 25-27 for a body's particles `p` by a team: each member sums its runs (in lanes from each
+// run's first particle, so that any team adds the same terms in the same order), then every member
+// adds all runs in order and finds the same frame. `rotation` warm-starts the extraction and
+// receives the result. The caller's next barrier must come before the sums are written again.
+ShapeMatchFrame shapeMatchFrameOf(const ShapeMatchModel& sm, const Point* p, std::span<ShapeMatchSums> sums,
+                                  const sweeps::LaneSweeps& lanes, const SolverTeam& team,
+                                  Eigen::Quaterniond& rotation) {
+  const std::size_t runs = sums.size(), n = sm.restOffsets.size();
+  const auto [first, last] = shapeMatchRuns(runs, team);
+  for (std::size_t k = first; k < last; ++k)
+    lanes.shapeMatchSums(p, sm.restOffsets.data(), sm.mass.data(), n * k / runs, n * (k + 1) / runs, sums[k]);
+  team.barrier();
+  ShapeMatchSums all = sums[0];
+  for (std::size_t k = 1; k < runs; ++k) all += sums[k];
+  return shapeMatchFrame(all, sm, rotation);
+}
+
+}  // namespace
+
+// What the damped sweeps compare with, at the start of the substep: F of every tet (each member a
+// share) and the shape-matching frame of the particles then.
+void World::recordSubstepStart(const sweeps::LanePlan& plan, const SolverTeam& team) {
   for (Body& b : bodies_) {
-    if (b.state != BodyState::Active || b.startDeformation.empty()) continue;
+    if (b.state != BodyState::Active) continue;
     const BodyModel& m = *b.model;
+    if (m.shapeMatching && m.damping.shapeMatching > 0.0f) {
+      Eigen::Quaterniond rotation = b.shapeMatchRotation;
+      const ShapeMatchFrame frame = shapeMatchFrameOf(*m.shapeMatching, local_.data() + b.firstParticle,
+                                                      shapeMatchSums_, *plan.widths[0], team, rotation);
+      team.barrier();  // every member has read the sums
+      if (team.leader()) b.shapeMatchStart = frame;
+    }
+    if (b.startDeformation.empty()) continue;
     const sweeps::Range r{nullptr, local_.data() + b.firstParticle, 0.0f, nullptr};
     const auto [begin, end] = team.share(0, m.strain.size(), 16);
     plan.run(begin, end, [&](const sweeps::LaneSweeps& s, std::size_t first, std::size_t last) {
@@ -781,26 +818,18 @@ void sweepColours(const std::vector<std::uint32_t>& colours, const std::vector<s
   team.barrier();
 }
 
-// Shape matching (eqs. 25-28) of one body by a team: each member sums its parts of the particles,
-// every member adds all parts in order and finds the same frame, and moves its parts' particles.
-// Each part's sums run in lanes from the part's first particle, so that any team adds the same
-// terms in the same order.
+// Shape matching (eqs. 25-28) of one body by a team: every member finds the same frame
+// (shapeMatchFrameOf) and moves its part of the particles; with damping, against the frame at the
+// start of the substep (Body::shapeMatchStart).
 void shapeMatching(Body& b, float tau, const sweeps::Range& r, std::span<ShapeMatchSums> sums,
                    const sweeps::LaneSweeps& lanes, const SolverTeam& team) {
   const ShapeMatchModel& sm = *b.model->shapeMatching;
-  const std::size_t parts = sums.size(), n = sm.restOffsets.size();
-  const auto part = [&](std::size_t k) { return n * k / parts; };
-  const std::size_t first = parts * std::size_t(team.index) / std::size_t(team.size),
-                    last = parts * std::size_t(team.index + 1) / std::size_t(team.size);
-  for (std::size_t k = first; k < last; ++k)
-    lanes.shapeMatchSums(r.pred, sm.restOffsets.data(), sm.mass.data(), part(k), part(k + 1), sums[k]);
-  team.barrier();
-  ShapeMatchSums all = sums[0];
-  for (std::size_t k = 1; k < parts; ++k) all += sums[k];
   Eigen::Quaterniond rotation = b.shapeMatchRotation;
-  const ShapeMatchFrame frame = shapeMatchFrame(all, sm, rotation);
-  lanes.shapeMatch(sm.restOffsets.data(), sm.compliance, frame, b.shapeMatchLambda.data(), tau, r, part(first),
-                   part(last));
+  const ShapeMatchFrame frame = shapeMatchFrameOf(sm, r.pred, sums, lanes, team, rotation);
+  const std::size_t runs = sums.size(), n = sm.restOffsets.size();
+  const auto [first, last] = shapeMatchRuns(runs, team);
+  lanes.shapeMatch(sm.restOffsets.data(), sm.compliance, frame, b.shapeMatchStart, b.shapeMatchLambda.data(), tau, r,
+                   n * first / runs, n * last / runs);
   team.barrier();  // every member has read the sums and the last rotation
   if (team.leader()) b.shapeMatchRotation = rotation;
 }

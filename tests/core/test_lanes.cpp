@@ -396,6 +396,9 @@ TEST(Lanes, ShapeMatchOfEveryWidthIsTheOneAtATimeShapeMatch) {
   ShapeMatchFrame frame;
   frame.centroid = vec();
   frame.rotation = Eigen::AngleAxisf(0.7f, vec().normalized()).toRotationMatrix();
+  ShapeMatchFrame startFrame;
+  startFrame.centroid = vec();
+  startFrame.rotation = Eigen::AngleAxisf(0.6f, vec().normalized()).toRotationMatrix();
   const float compliance = 1e-4f, invH = 600.0f;
   for (float tau : {0.0f, 0.002f})
     for (std::size_t begin : {0u, 3u})
@@ -403,8 +406,8 @@ TEST(Lanes, ShapeMatchOfEveryWidthIsTheOneAtATimeShapeMatch) {
         const auto goals = [&](SimdLevel level, std::vector<Point>& p, std::vector<Vec3>& l) {
           p = pred, l = lambda;
           const sweeps::Range r{p.data(), start.data(), invH, nullptr};
-          sweeps::lanePlan(level).widths[0]->shapeMatch(offsets.data(), compliance, frame, l.data(), tau, r, begin,
-                                                        begin + count);
+          sweeps::lanePlan(level).widths[0]->shapeMatch(offsets.data(), compliance, frame, startFrame, l.data(), tau, r,
+                                                        begin, begin + count);
         };
         std::vector<Point> reference;
         std::vector<Vec3> referenceLambda;

@@ -39,6 +39,9 @@ struct Body {
   /// project both (SolverSettings::fuseStrainVolume); a hand-built model need not pair them.
   bool tetsPaired = false;
   Eigen::Quaterniond shapeMatchRotation = Eigen::Quaterniond::Identity();  ///< R of the last shape match (warm start)
+  /// The shape-matching frame of the particles at the start of the substep, for its damping: the
+  /// goals' own motion is no strain rate, so a body falling or turning freely is not damped.
+  ShapeMatchFrame shapeMatchStart{Vec3::Zero(), Mat3::Identity()};
 
   /// Where the body's frame is: the solver keeps its particles' positions relative to this point,
   /// which follows the centre of mass of its moving particles, so that their float resolution is

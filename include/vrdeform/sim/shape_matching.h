@@ -74,13 +74,15 @@ inline ShapeMatchFrame shapeMatchFrame(const Point* p, const ShapeMatchModel& mo
 }
 
 /// Eq. 28 for one particle: the change of its vector multiplier; its correction is w dLambda.
-/// `k` holds alpha/h^2 of a unit-mass particle and tau/h; `disp` is the particle's motion in the substep.
+/// `k` holds alpha/h^2 of a unit-mass particle and tau/h; `change` (damping) is the change of
+/// C = p - goal in the substep: the particle's motion less its goal's, so that the frame's own
+/// motion (a body falling or turning) is not damped.
 inline Vec3 solveShapeMatchParticle(const Point& p, const Vec3& goal, const Vec3& lambda, const XpbdCoefficients& k,
-                                    const Vec3& disp = Vec3::Zero()) {
+                                    const Vec3& change = Vec3::Zero()) {
   if (p.w == 0.0f) return Vec3::Zero();
   const float alphaTilde = k.alphaTilde * p.w;                                // alpha_i = alpha / m_i
   const float invDenominator = 1.0f / ((1.0f + k.gamma) * p.w + alphaTilde);  // one division, not three
-  return (goal - p.pos - alphaTilde * lambda - k.gamma * disp) * invDenominator;
+  return (goal - p.pos - alphaTilde * lambda - k.gamma * change) * invDenominator;
 }
 
 }  // namespace vrd

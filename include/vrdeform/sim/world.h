@@ -179,7 +179,7 @@ class World {
   void coldStart(BodyId id);                                             // zeroes the body's multipliers
   void warmStart(const sweeps::LanePlan& plan, const SolverTeam& team);  // moves the predictions by the multipliers
   bool warmPushesFit() const;  // the warm start moved no particle too far to be a guess
-  void startDeformations(const sweeps::LanePlan& plan, const SolverTeam& team);
+  void recordSubstepStart(const sweeps::LanePlan& plan, const SolverTeam& team);
   void solveIteration(float h, const sweeps::LanePlan& plan, const SolverTeam& team, bool measure);
   template <typename Sweep>
   void measured(Stage stage, const Body* body, bool measure, const SolverTeam& team, Sweep&& sweep);
