@@ -25,6 +25,8 @@ packages=(
   libglfw3-dev libimgui-dev libstb-dev   # desktop viewer window and panels; PNG frames
   xvfb xauth          # the viewer's test under a virtual X server
   ffmpeg              # MP4 from headless frames (vrdeform render; optional at run time)
+  python3-dev pybind11-dev python3-numpy python3-pytest   # the Python module (python/) and its tests
+  python3-matplotlib python3-nbconvert python3-ipykernel   # the Python examples: plots, the notebook run in the tests
 )
 
 command -v node >/dev/null || packages+=(nodejs npm)  # the VR page's npm packages and browser test

@@ -1,0 +1,211 @@
+// Scenes from Python: scene files and the built-in scenes, built and settled, run by the same loop
+// as `vrdeform run` (runScene), with the hand scripted, or driven from Python, and a callback per
+// step.
+
+#include <fmt/format.h>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "bindings.h"
+#include "vrdeform/error.h"
+#include "vrdeform/interact/hand_input.h"
+#include "vrdeform/scene/scene_builder.h"
+#include "vrdeform/scene/scene_file.h"
+#include "vrdeform/scene/scene_library.h"
+#include "vrdeform/scene/scene_run.h"
+
+namespace py = pybind11;
+
+namespace vrd::python {
+namespace {
+
+// A hand whose fingertips a Python callable places each step: hand(step, time) returns the five
+// fingertip centres (thumb to little) as a (5, 3) array, or None when it is done.
+class PythonHand final : public HandInput {
+ public:
+  explicit PythonHand(py::function hand) : hand_(std::move(hand)) {}
+  ~PythonHand() override {
+    py::gil_scoped_acquire gil;
+    hand_ = py::function();
+  }
+
+  HandFrame frame(std::uint64_t step, double time) override {
+    py::gil_scoped_acquire gil;
+    py::object r;
+    try {
+      r = hand_(step, time);
+    } catch (py::error_already_set& e) {  // raised again once the run has stopped
+      error = std::move(e);
+      finished_ = true;
+      return last_;
+    }
+    if (r.is_none()) {
+      finished_ = true;
+      return last_;
+    }
+    const auto tips = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(r);
+    if (!tips || tips.ndim() != 2 || tips.shape(0) != kFingerCount || tips.shape(1) != 3)
+      throw Error(fmt::format("hand(step, time) must return a (5, 3) array of fingertip centres or None, got {}",
+                              std::string(py::str(py::repr(r)))));
+    last_.direct = true;
+    for (int f = 0; f < kFingerCount; ++f) {
+      const Vec3 p(tips.at(f, 0), tips.at(f, 1), tips.at(f, 2));
+      if (!p.allFinite()) throw Error(fmt::format("hand(step, time): fingertip {} is not finite", f));
+      last_.fingertips[std::size_t(f)] = p;
+    }
+    return last_;
+  }
+  bool finished(std::uint64_t, double) const override { return finished_; }
+
+  std::optional<py::error_already_set> error;  ///< what the callable raised
+
+ private:
+  py::function hand_;
+  HandFrame last_;
+  bool finished_ = false;
+};
+
+// One finished step as the callback sees it.
+py::dict stepInfo(const RunStep& s) {
+  py::dict d;
+  d["step"] = s.step;
+  d["time"] = s.time;
+  d["volume_loss"] = s.volumeLoss;
+  d["haptics"] = s.session ? py::cast(s.session->haptics()) : py::none();
+  return d;
+}
+
+py::object summaryDict(const RunSummary& summary) {
+  return py::module_::import("json").attr("loads")(summaryJson(summary));
+}
+
+}  // namespace
+
+void bindScene(py::module_& m) {
+  py::class_<SceneSpec>(m, "SceneSpec", "What a scene file says (docs/scenes.md); change it before build_scene")
+      .def_readwrite("name", &SceneSpec::name)
+      .def_readwrite("description", &SceneSpec::description)
+      .def_readonly("source", &SceneSpec::source)
+      .def_readwrite("solver", &SceneSpec::solver)
+      .def_readwrite("settle", &SceneSpec::settle, "s the bodies settle before the interaction")
+      .def_readwrite("seconds", &SceneSpec::seconds, "default length of a run (s)")
+      .def_property(
+          "hand_enabled", [](const SceneSpec& s) { return s.hand.enabled; },
+          [](SceneSpec& s, bool on) { s.hand.enabled = on; })
+      .def_property(
+          "calibrate", [](const SceneSpec& s) { return s.haptics.calibrate; },
+          [](SceneSpec& s, bool on) { s.haptics.calibrate = on; }, "calibrate the haptic model after settling")
+      .def_property_readonly("bodies", [](const SceneSpec& s) {
+        std::vector<std::string> names;
+        for (const BodySpec& b : s.bodies) names.push_back(b.name);
+        return names;
+      });
+
+  m.def("load_scene", &loadSceneByName, py::arg("name_or_path"),
+        "A built-in scene by name (liver, jelly, ...) or a scene file (.toml)");
+  m.def(
+      "parse_scene",
+      [](const std::string& text, const std::filesystem::path& baseDir) {
+        return parseScene(text, "<python>", std::filesystem::absolute(baseDir));
+      },
+      py::arg("text"), py::arg("base_dir") = std::filesystem::path("."),
+      "A scene from TOML text; mesh paths are relative to base_dir");
+  m.def("builtin_scenes", [] {
+    std::vector<std::string> names;
+    for (const SceneEntry& e : builtinScenes()) names.push_back(e.name);
+    return names;
+  });
+
+  py::class_<BuiltScene>(m, "Scene", "A built and settled scene: its world, bodies and scripted hand")
+      .def_readonly("spec", &BuiltScene::spec)
+      .def_property_readonly(
+          "world", [](BuiltScene& s) -> World& { return *s.world; }, py::return_value_policy::reference_internal,
+          "the scene's World (alive as long as the scene)")
+      .def_property_readonly(
+          "bodies",
+          [](const BuiltScene& s) {
+            py::dict d;
+            for (const SceneBody& b : s.bodies) d[py::str(b.name)] = b.id;
+            return d;
+          },
+          "body name -> id in the world")
+      .def_readonly("settle_seconds", &BuiltScene::settleSeconds)
+      .def(
+          "run",
+          [](BuiltScene& scene, std::optional<std::uint64_t> steps, const std::filesystem::path& out,
+             const std::optional<py::function>& callback, const std::optional<py::function>& hand) {
+            RunSettings settings;
+            const double dt = scene.spec.solver.timeStep;
+            settings.steps =
+                steps ? *steps
+                      : std::max<std::uint64_t>(1, std::uint64_t(std::min(std::round(scene.spec.seconds / dt), 1e15)));
+            settings.outDir = out;
+            std::optional<PythonHand> pythonHand;
+            if (hand) {
+              if (!scene.spec.hand.enabled) throw Error("hand: this scene has no hand (its [hand] enabled = false)");
+              pythonHand.emplace(*hand);
+              settings.input = &*pythonHand;
+            }
+            // Ctrl-C, the hand's end and an exception in the callback or the hand end the run after
+            // the step in progress; the exception is raised once the run has stopped.
+            std::optional<py::error_already_set> error;
+            auto lastCheck = std::chrono::steady_clock::now();
+            settings.afterStep = [&](const RunStep& s) {
+              if (pythonHand && pythonHand->finished(s.step, s.time)) return false;
+              const auto now = std::chrono::steady_clock::now();
+              if (!callback && now - lastCheck < std::chrono::milliseconds(50)) return true;
+              lastCheck = now;
+              py::gil_scoped_acquire gil;
+              try {
+                if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+                if (!callback) return true;
+                const py::object r = (*callback)(stepInfo(s));
+                return r.is_none() || r.cast<bool>();
+              } catch (py::error_already_set& e) {
+                error = std::move(e);
+                return false;
+              }
+            };
+            RunSummary summary;
+            {
+              py::gil_scoped_release release;
+              summary = runScene(scene, settings);
+            }
+            if (pythonHand && pythonHand->error) throw std::move(*pythonHand->error);
+            if (error) throw std::move(*error);
+            return summaryDict(summary);
+          },
+          py::arg("steps") = py::none(), py::arg("out") = std::filesystem::path(), py::arg("callback") = py::none(),
+          py::arg("hand") = py::none(),
+          R"(Runs the scene as `vrdeform run` does; returns its summary (summary.json's keys) as a dict.
+
+steps: steps to run (default: the scene's seconds); out: a folder for the run's files (forces.csv,
+meshes, plots, summary.json), none by default; callback(step) after every step, with a dict of
+step, time, volume_loss and haptics (a HapticFrame), returning False to stop; hand(step, time)
+places the five fingertips instead of the scene's script: a (5, 3) array, or None to end the run
+after that step, the hand held where it was. The
+GIL is released while the solver runs; Ctrl-C stops the run after the step in progress.)");
+
+  m.def(
+      "build_scene",
+      [](const SceneSpec& spec, bool verbose) {
+        SceneLog log;
+        if (verbose)
+          log = [](std::string_view line) {
+            py::gil_scoped_acquire gil;
+            py::print(std::string(line));
+          };
+        py::gil_scoped_release release;
+        return buildScene(spec, log);
+      },
+      py::arg("spec"), py::arg("verbose") = false,
+      "Builds the scene: meshes its bodies, settles them and calibrates the haptics (as `vrdeform run` does)");
+}
+
+}  // namespace vrd::python

@@ -1,0 +1,13 @@
+#pragma once
+// The Python module's parts (docs/python.md): each binds one layer's types into the module.
+
+#include <pybind11/pybind11.h>
+
+namespace vrd::python {
+
+void bindMesh(pybind11::module_& m);     // meshes: reading, checking, tetrahedralising
+void bindWorld(pybind11::module_& m);    // the solver: settings, materials, colliders, World
+void bindHaptics(pybind11::module_& m);  // fingers and their haptic outputs
+void bindScene(pybind11::module_& m);    // scene files, built scenes and the run loop
+
+}  // namespace vrd::python

@@ -1,0 +1,17 @@
+// import vrdeform: the engine, meshes, scenes and the haptic model from Python (docs/python.md).
+
+#include <pybind11/pybind11.h>
+
+#include "bindings.h"
+#include "vrdeform/error.h"
+
+PYBIND11_MODULE(_vrdeform, m) {
+  m.doc() = "vrdeform: XPBD deformable bodies and their haptic force signal";
+  // vrd::Error (bad input, a failed mesher, a scene that does not settle) arrives as
+  // vrdeform.Error, a RuntimeError, with the message the command-line programs print.
+  pybind11::register_exception<vrd::Error>(m, "Error", PyExc_RuntimeError);
+  vrd::python::bindMesh(m);
+  vrd::python::bindWorld(m);
+  vrd::python::bindHaptics(m);
+  vrd::python::bindScene(m);
+}
