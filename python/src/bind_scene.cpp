@@ -138,14 +138,14 @@ void bindScene(py::module_& m) {
       .def_readonly("settle_seconds", &BuiltScene::settleSeconds)
       .def(
           "run",
-          [](BuiltScene& scene, std::optional<std::uint64_t> steps, const std::filesystem::path& out,
+          [](BuiltScene& scene, std::optional<std::uint64_t> steps, const std::optional<std::filesystem::path>& out,
              const std::optional<py::function>& callback, const std::optional<py::function>& hand) {
             RunSettings settings;
             const double dt = scene.spec.solver.timeStep;
             settings.steps =
                 steps ? *steps
                       : std::max<std::uint64_t>(1, std::uint64_t(std::min(std::round(scene.spec.seconds / dt), 1e15)));
-            settings.outDir = out;
+            if (out) settings.outDir = *out;
             std::optional<PythonHand> pythonHand;
             if (hand) {
               if (!scene.spec.hand.enabled) throw Error("hand: this scene has no hand (its [hand] enabled = false)");
@@ -181,7 +181,7 @@ void bindScene(py::module_& m) {
             if (error) throw std::move(*error);
             return summaryDict(summary);
           },
-          py::arg("steps") = py::none(), py::arg("out") = std::filesystem::path(), py::arg("callback") = py::none(),
+          py::arg("steps") = py::none(), py::arg("out") = py::none(), py::arg("callback") = py::none(),
           py::arg("hand") = py::none(),
           R"(Runs the scene as `vrdeform run` does; returns its summary (summary.json's keys) as a dict.
 

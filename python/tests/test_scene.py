@@ -40,10 +40,12 @@ def test_a_run_matches_the_command_line_program_bit_for_bit(cli, tmp_path):
     np.testing.assert_array_equal(got, want)
 
 
-def test_the_callback_can_stop_a_run_and_its_exceptions_arrive():
+def test_the_callback_can_stop_a_run_and_its_exceptions_arrive(tmp_path, monkeypatch):
     scene = vrdeform.build_scene(vrdeform.load_scene("jelly"))
+    monkeypatch.chdir(tmp_path)
     summary = scene.run(steps=100, callback=lambda s: s["step"] < 9)
     assert summary["steps"] == 10
+    assert summary["files"] == [] and not any(tmp_path.iterdir()), "no out: no files"
 
     def fail(step):
         raise ValueError("from the callback")
