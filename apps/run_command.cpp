@@ -9,10 +9,10 @@
 #include <optional>
 #include <string>
 
-#include "glove_link.h"
 #include "scene_video.h"
 #include "vrdeform/core/write_file.h"
 #include "vrdeform/devices/csv_recorder.h"
+#include "vrdeform/devices/glove_link.h"
 #include "vrdeform/devices/osc_output.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"

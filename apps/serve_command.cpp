@@ -13,7 +13,7 @@
 #include <thread>
 #include <vector>
 
-#include "glove_link.h"
+#include "vrdeform/devices/glove_link.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
 #include "vrdeform/scene/scene_library.h"
@@ -102,7 +102,7 @@ int serve(const ServeArgs& a) {
   const auto start = std::chrono::steady_clock::now();
   while (loop.running() && !signals.requested()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    if (glove) glove->printEvents();
+    if (glove) glove->reportEvents();
     if (a.seconds > 0 && std::chrono::steady_clock::now() - start > std::chrono::duration<double>(a.seconds)) break;
   }
   server.stop();

@@ -21,9 +21,9 @@
 #include <utility>
 #include <vector>
 
-#include "glove_link.h"
 #include "vrdeform/core/atomic_file.h"
 #include "vrdeform/devices/csv_recorder.h"
+#include "vrdeform/devices/glove_link.h"
 #include "vrdeform/devices/osc_output.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"

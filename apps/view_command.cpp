@@ -2,8 +2,8 @@
 
 #include <memory>
 
-#include "glove_link.h"
 #include "viewer/viewer.h"
+#include "vrdeform/devices/glove_link.h"
 
 namespace vrd {
 

@@ -15,7 +15,7 @@
 #include <optional>
 #include <vector>
 
-#include "../glove_link.h"
+#include "vrdeform/devices/glove_link.h"
 #include "vrdeform/devices/haptic_output.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
@@ -438,7 +438,7 @@ int Viewer::run() {
         fmt::print(stderr, "vrdeform: the simulation stopped: {}\n", e.what());
       }
     }
-    if (running_->glove) running_->glove->printEvents();
+    if (running_->glove) running_->glove->reportEvents();
     takeSnapshot();
 
     ImGui_ImplOpenGL3_NewFrame();

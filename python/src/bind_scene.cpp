@@ -13,8 +13,11 @@
 #include <optional>
 
 #include "bindings.h"
+#include "vrdeform/devices/glove_link.h"
 #include "vrdeform/error.h"
 #include "vrdeform/interact/hand_input.h"
+#include "vrdeform/interact/hand_script.h"
+#include "vrdeform/interact/session_recording.h"
 #include "vrdeform/scene/scene_builder.h"
 #include "vrdeform/scene/scene_file.h"
 #include "vrdeform/scene/scene_library.h"
@@ -122,6 +125,24 @@ void bindScene(py::module_& m) {
     return names;
   });
 
+  py::class_<HandScript>(m, "HandScript", "A hand script: wrist keyframes and finger closures (docs/hand-input.md)")
+      .def_static("load", &HandScript::load, py::arg("path"))
+      .def_static(
+          "parse", [](const std::string& text) { return HandScript::parse(text, "<python>"); }, py::arg("text"))
+      .def_property_readonly("duration", &HandScript::duration, "the last keyframe's time (s)")
+      .def("save", &HandScript::save, py::arg("path"));
+  py::class_<SessionRecording>(
+      m, "SessionRecording", "A recorded session's hand, step by step (`vrdeform touch --record`); replays bit for bit")
+      .def_static("load", &SessionRecording::load, py::arg("path"))
+      .def_static(
+          "parse", [](const std::string& text) { return SessionRecording::parse(text, "<python>"); }, py::arg("text"))
+      .def("__len__", [](const SessionRecording& r) { return r.steps.size(); })
+      .def_property_readonly("settings", [](const SessionRecording& r) {
+        py::dict d;
+        for (const auto& [key, value] : r.settings) d[py::str(key)] = value;
+        return d;
+      });
+
   py::class_<BuiltScene>(m, "Scene", "A built and settled scene: its world, bodies and scripted hand")
       .def_readonly("spec", &BuiltScene::spec)
       .def_property_readonly(
@@ -136,27 +157,77 @@ void bindScene(py::module_& m) {
           },
           "body name -> id in the world")
       .def_readonly("settle_seconds", &BuiltScene::settleSeconds)
+      .def_property_readonly(
+          "calibration",
+          [](const BuiltScene& s) -> py::object {
+            if (!s.calibration) return py::none();
+            const HapticCalibration& c = *s.calibration;
+            py::dict d;
+            d["tau_contact"] = c.signal.tauContact;
+            d["tau_finger_contact"] = c.signal.tauFingerContact;
+            d["tau_volume"] = c.signal.tauVolume;
+            d["tau_strain"] = c.signal.tauStrain;
+            d["point"] = py::make_tuple(c.point.x(), c.point.y(), c.point.z());
+            d["direction"] = py::make_tuple(c.direction.x(), c.direction.y(), c.direction.z());
+            d["depth"] = c.depth;
+            d["force"] = c.force;
+            d["contacts"] = c.contacts;
+            return d;
+          },
+          "The haptic model's calibration poke (docs/haptics.md): the tau it chose, where it pressed, how deep, "
+          "with what force (N); None without one")
       .def(
           "run",
           [](BuiltScene& scene, std::optional<std::uint64_t> steps, const std::optional<std::filesystem::path>& out,
-             const std::optional<py::function>& callback, const std::optional<py::function>& hand) {
+             const std::optional<py::function>& callback, const py::object& hand,
+             const std::optional<std::string>& weart, const std::optional<py::function>& gloveNews) {
+            if ((!hand.is_none() || weart) && !scene.spec.hand.enabled)
+              throw Error("this scene has no hand (its [hand] enabled = false)");
+            if (!hand.is_none() && weart) throw Error("hand and weart: one source for the hand");
             RunSettings settings;
             const double dt = scene.spec.solver.timeStep;
             settings.steps =
                 steps ? *steps
                       : std::max<std::uint64_t>(1, std::uint64_t(std::min(std::round(scene.spec.seconds / dt), 1e15)));
             if (out) settings.outDir = *out;
-            std::optional<PythonHand> pythonHand;
-            if (hand) {
-              if (!scene.spec.hand.enabled) throw Error("hand: this scene has no hand (its [hand] enabled = false)");
-              pythonHand.emplace(*hand);
-              settings.input = &*pythonHand;
+            // The hand: the scene's script, or a Python callable, a hand script, a recording or a glove.
+            std::unique_ptr<HandInput> input;
+            PythonHand* pythonHand = nullptr;
+            if (py::isinstance<HandScript>(hand))
+              input = std::make_unique<HandScriptInput>(hand.cast<HandScript>());
+            else if (py::isinstance<SessionRecording>(hand)) {
+              const auto& recording = hand.cast<const SessionRecording&>();
+              input = std::make_unique<RecordingInput>(recording);
+              if (!steps) settings.steps = std::max<std::size_t>(1, recording.steps.size());
+            } else if (!hand.is_none()) {
+              if (!PyCallable_Check(hand.ptr()))
+                throw Error("hand: a callable hand(step, time), a HandScript or a SessionRecording");
+              auto owned = std::make_unique<PythonHand>(hand.cast<py::function>());
+              pythonHand = owned.get();
+              input = std::move(owned);
             }
-            // Ctrl-C, the hand's end and an exception in the callback or the hand end the run after
-            // the step in progress; the exception is raised once the run has stopped.
+            std::optional<GloveLink> glove;
+            if (weart) {
+              GloveNews news = [gloveNews](std::string_view line, bool error) {
+                py::gil_scoped_acquire gil;
+                if (gloveNews)
+                  (*gloveNews)(std::string(line), error);
+                else
+                  py::print("glove:", std::string(line),
+                            py::arg("file") = py::module_::import("sys").attr(error ? "stderr" : "stdout"));
+              };
+              const Vec3 point = scene.actions.empty() ? scene.bodies.front().top : scene.actions.front().target;
+              glove.emplace(*weart, scene.session.hand, point, std::move(news));
+              settings.input = &glove->input();
+            } else {
+              settings.input = input.get();
+            }
+            // Ctrl-C, the end of a Python hand, and an exception in the callback or the hand end the
+            // run after the step in progress; the exception is raised once the run has stopped.
             std::optional<py::error_already_set> error;
             auto lastCheck = std::chrono::steady_clock::now();
             settings.afterStep = [&](const RunStep& s) {
+              if (glove && s.session) glove->afterStep(s.session->haptics(), s.time);
               if (pythonHand && pythonHand->finished(s.step, s.time)) return false;
               const auto now = std::chrono::steady_clock::now();
               if (!callback && now - lastCheck < std::chrono::milliseconds(50)) return true;
@@ -175,22 +246,32 @@ void bindScene(py::module_& m) {
             RunSummary summary;
             {
               py::gil_scoped_release release;
-              summary = runScene(scene, settings);
+              try {
+                summary = runScene(scene, settings);
+              } catch (...) {
+                if (glove) glove->shutdown();
+                throw;
+              }
+              if (glove) glove->shutdown();  // every thimble released before run returns
             }
             if (pythonHand && pythonHand->error) throw std::move(*pythonHand->error);
             if (error) throw std::move(*error);
             return summaryDict(summary);
           },
           py::arg("steps") = py::none(), py::arg("out") = py::none(), py::arg("callback") = py::none(),
-          py::arg("hand") = py::none(),
+          py::arg("hand") = py::none(), py::arg("weart") = py::none(), py::arg("glove_news") = py::none(),
           R"(Runs the scene as `vrdeform run` does; returns its summary (summary.json's keys) as a dict.
 
-steps: steps to run (default: the scene's seconds); out: a folder for the run's files (forces.csv,
-meshes, plots, summary.json), none by default; callback(step) after every step, with a dict of
-step, time, volume_loss and haptics (a HapticFrame), returning False to stop; hand(step, time)
-places the five fingertips instead of the scene's script: a (5, 3) array, or None to end the run
-after that step, the hand held where it was. The
-GIL is released while the solver runs; Ctrl-C stops the run after the step in progress.)");
+steps: steps to run (default: the scene's seconds, or a recording's length); out: a folder for the
+run's files (forces.csv, meshes, plots, summary.json), none by default; callback(step) after every
+step, with a dict of step, time, volume_loss and haptics (a HapticFrame), returning False to stop.
+The hand is the scene's script unless given: hand(step, time), a callable returning the five
+fingertip centres (thumb to little) as a (5, 3) array, or None to end the run after that step with
+the hand held where it was; a HandScript; a SessionRecording, replayed step by step; or a WEART
+glove, weart="HOST[:PORT]" of its middleware, whose closures drive the hand over the body while
+its thimbles get each finger's force, paced to real time (glove_news(line, error) gets the
+connection's news, printed by default; every thimble is released when the run ends). The GIL is
+released while the solver runs; Ctrl-C stops the run after the step in progress.)");
 
   m.def(
       "build_scene",

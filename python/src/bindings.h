@@ -8,6 +8,7 @@ namespace vrd::python {
 void bindMesh(pybind11::module_& m);     // meshes: reading, checking, tetrahedralising
 void bindWorld(pybind11::module_& m);    // the solver: settings, materials, colliders, World
 void bindHaptics(pybind11::module_& m);  // fingers and their haptic outputs
+void bindDevices(pybind11::module_& m);  // the fake WEART middleware
 void bindScene(pybind11::module_& m);    // scene files, built scenes and the run loop
 
 }  // namespace vrd::python

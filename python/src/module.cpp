@@ -13,5 +13,6 @@ PYBIND11_MODULE(_vrdeform, m) {
   vrd::python::bindMesh(m);
   vrd::python::bindWorld(m);
   vrd::python::bindHaptics(m);
+  vrd::python::bindDevices(m);
   vrd::python::bindScene(m);
 }

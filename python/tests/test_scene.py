@@ -29,6 +29,8 @@ def test_a_run_matches_the_command_line_program_bit_for_bit(cli, tmp_path):
 
     summary = scene.run(steps=steps, callback=record)
     assert summary["ok"] and summary["steps"] == steps and len(rows) == steps
+    c = scene.calibration
+    assert c["force"] > 0 and c["depth"] > 0 and c["tau_contact"] > 0
     subprocess.run([str(cli), "run", "liver", "--steps", str(steps), "--out", str(tmp_path)],
                    check=True, capture_output=True)
     with open(tmp_path / "forces.csv") as f:

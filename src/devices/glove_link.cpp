@@ -1,4 +1,4 @@
-#include "glove_link.h"
+#include "vrdeform/devices/glove_link.h"
 
 #include <fmt/format.h>
 
@@ -37,18 +37,19 @@ std::string weartEndpointError(const std::string& endpoint) {
   }
 }
 
-GloveLink::GloveLink(const std::string& endpoint, const HandRigSettings& hand, const Vec3& point)
-    : client_(clientSettings(endpoint, hand)) {
+void printGloveNews(std::string_view line, bool error) { fmt::print(error ? stderr : stdout, "glove: {}\n", line); }
+
+GloveLink::GloveLink(const std::string& endpoint, const HandRigSettings& hand, const Vec3& point, GloveNews news)
+    : client_(clientSettings(endpoint, hand)), news_(std::move(news)) {
   const weart::ClientSettings& cs = client_.settings();
   client_.start();
   input_.emplace(client_, wristAbove(point, hand.geometry));
   name_ = fmt::format("glove {}:{}", cs.host, cs.port);
-  fmt::print("input: WEART glove via the middleware at {}:{} (Ctrl-C stops; the glove is released)\n", cs.host,
-             cs.port);
+  news_(fmt::format("the WEART middleware at {}:{} (Ctrl-C stops; the glove is released)", cs.host, cs.port), false);
 }
 
-void GloveLink::printEvents() {
-  for (const weart::Event& e : client_.takeEvents()) fmt::print(e.error ? stderr : stdout, "glove: {}\n", e.message);
+void GloveLink::reportEvents() {
+  for (const weart::Event& e : client_.takeEvents()) news_(e.message, e.error);
 }
 
 std::optional<float> GloveLink::closure(Finger finger) const {
@@ -66,7 +67,7 @@ void GloveLink::afterStep(const HapticFrame& frame, double time) {
   std::array<float, kFingerCount> force{};
   for (int f = 0; f < kFingerCount; ++f) force[f] = frame.fingers[f].force;
   client_.publishForces(force);
-  printEvents();
+  reportEvents();
   if (!start_)
     start_ = std::chrono::steady_clock::now() -
              std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(time));

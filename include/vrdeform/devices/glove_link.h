@@ -1,13 +1,15 @@
 #pragma once
-// A WEART glove as the hand of a command's simulation (`--weart HOST:PORT`): its finger closures
-// drive a palm-down hand held over a point of the body, each finger's force goes back to its
-// thimble, and the loop is paced to real time. The client's thread does the I/O, so a missing or
-// slow glove never stalls the simulation; every thimble is released at shutdown (and by the
-// client's watchdog, signals and destructor).
+// A WEART glove as the hand of a simulation (the commands' `--weart HOST:PORT`, Python's
+// Scene.run(weart=...)): its finger closures drive a palm-down hand held over a point of the body,
+// each finger's force goes back to its thimble, and the loop is paced to real time. The client's
+// thread does the I/O, so a missing or slow glove never stalls the simulation; every thimble is
+// released at shutdown (and by the client's watchdog, signals and destructor).
 
 #include <chrono>
+#include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "vrdeform/devices/glove_input.h"
 #include "vrdeform/devices/haptic_output.h"
@@ -20,22 +22,28 @@ namespace vrd {
 /// else why not, so that a malformed one is refused at once instead of retried.
 std::string weartEndpointError(const std::string& endpoint);
 
+/// Where a link's news goes: a line (connection changes, errors) and whether it is an error.
+using GloveNews = std::function<void(std::string_view line, bool error)>;
+/// The commands' news: errors to stderr, the rest to stdout, each line prefixed "glove: ".
+void printGloveNews(std::string_view line, bool error);
+
 class GloveLink {
  public:
   /// Connects in the background to `endpoint` (HOST[:PORT]) with a thimble per finger of `hand`;
   /// the wrist is held palm down over `point`, so that closing the hand brings the fingertips onto it.
-  GloveLink(const std::string& endpoint, const HandRigSettings& hand, const Vec3& point);
+  GloveLink(const std::string& endpoint, const HandRigSettings& hand, const Vec3& point,
+            GloveNews news = printGloveNews);
 
   HandInput& input() { return *input_; }
   const std::string& name() const { return name_; }
-  /// After the step that ends at simulation time `time`: publishes the forces, prints the client's
-  /// news and sleeps until that time has passed on the wall clock (from the first call).
+  /// After the step that ends at simulation time `time`: publishes the forces, passes on the
+  /// client's news and sleeps until that time has passed on the wall clock (from the first call).
   void afterStep(const HapticFrame& frame, double time);
   /// The thimbles as one of a `SimulationLoop`'s outputs (viewer, VR server): each step's forces,
   /// published from the loop's thread without waiting, which also keeps the watchdog quiet.
   HapticOutput& output() { return output_; }
-  /// Prints the client's news (connection changes, errors) since the last call.
-  void printEvents();
+  /// Passes on the client's news (connection changes, errors) since the last call.
+  void reportEvents();
   /// The glove's latest closure of `finger` in [0, 1]; nullopt before its first tracking frame.
   std::optional<float> closure(Finger finger) const;
   /// Whether the middleware session runs, so that forces reach the glove.
@@ -52,6 +60,7 @@ class GloveLink {
   };
 
   weart::Client client_;
+  GloveNews news_;
   Output output_{client_};
   std::optional<weart::GloveInput> input_;
   std::string name_;
