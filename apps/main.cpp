@@ -27,7 +27,8 @@ int main(int argc, char** argv) {
   const auto runSoakCommand = vrd::addSoakCommand(app);
 
   // Exit status: 0 fine; 1 a run failed part-way, a mesh has defects or a replay differs; 2 bad
-  // input, usage errors included (CLI11's own codes are folded into 2).
+  // input, usage errors included (CLI11's own codes are folded into 2); 130 stopped by Ctrl-C (or
+  // SIGTERM) before its run began (meshing, settling, calibrating).
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -45,6 +46,9 @@ int main(int argc, char** argv) {
   } catch (const vrd::Error& e) {
     fmt::print(stderr, "vrdeform: {}\n", e.what());
     return 2;
+  } catch (const vrd::Stopped& e) {
+    fmt::print(stderr, "\nvrdeform: {}\n", e.what());
+    return 130;
   }
   return 0;
 }

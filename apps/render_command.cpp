@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "build_observer.h"
 #include "scene_video.h"
 #include "vrdeform/core/write_file.h"
 #include "vrdeform/devices/stop_signals.h"
@@ -26,7 +27,8 @@ int render(const RenderArgs& a) {
   prepareOutputFolder(a.out);
   const SceneSpec spec = loadSceneByName(a.scene);
   fmt::print("scene {}: {}\n", spec.name, spec.description);
-  BuiltScene scene = buildScene(spec, [](std::string_view line) { fmt::print("{}\n", line); });
+  const StopSignals signals;
+  BuiltScene scene = buildScene(spec, commandObserver(signals));
   std::optional<SceneVideo> video;
   try {
     video.emplace(scene, a.out, a.video);
@@ -37,7 +39,6 @@ int render(const RenderArgs& a) {
   const double seconds = a.seconds > 0.0 ? a.seconds : spec.seconds;
   RunSettings settings;
   settings.steps = std::max<std::uint64_t>(1, std::uint64_t(std::llround(seconds / spec.solver.timeStep)));
-  const StopSignals signals;
   settings.afterStep = [&](const RunStep& s) {
     video->afterStep(s);
     return !signals.requested();

@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "build_observer.h"
 #include "scene_video.h"
 #include "vrdeform/core/write_file.h"
 #include "vrdeform/devices/csv_recorder.h"
@@ -178,8 +179,8 @@ int run(const RunArgs& a) {
   if (a.iterations > 0) spec.solver.iterations = a.iterations;
   validateSolverSettings(spec.solver);
   fmt::print("scene {}: {}\n  from {}\n", spec.name, spec.description, spec.source);
-  const auto log = [](std::string_view line) { fmt::print("{}\n", line); };
-  BuiltScene scene = buildScene(spec, log);
+  const StopSignals signals;  // from here on Ctrl-C stops what runs: meshing, settling, calibrating, the run
+  BuiltScene scene = buildScene(spec, commandObserver(signals));
   printScene(scene);
 
   const double dt = spec.solver.timeStep;
@@ -218,7 +219,6 @@ int run(const RunArgs& a) {
     }
   }
   Progress progress(seconds, a.reportEvery, dt, spec.hand.enabled);
-  const StopSignals signals;
   settings.afterStep = [&](const RunStep& s) {
     progress.step(s);
     if (video) video->afterStep(s);

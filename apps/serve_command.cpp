@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "build_observer.h"
 #include "vrdeform/devices/glove_link.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
@@ -63,7 +64,8 @@ int serve(const ServeArgs& a) {
   const SceneSpec spec = loadSceneByName(a.scene);
   fmt::print("scene {}: {}\n", spec.name, spec.description);
   std::fflush(stdout);
-  BuiltScene scene = buildScene(spec);
+  const StopSignals signals;
+  BuiltScene scene = buildScene(spec, commandObserver(signals, false));
   const std::filesystem::path web = webFolder();
   if (!hasThreeJs(web))
     fmt::print(stderr,
@@ -98,7 +100,6 @@ int serve(const ServeArgs& a) {
              (web / "public").string());
   printAddresses(a, server.port());
 
-  const StopSignals signals;
   const auto start = std::chrono::steady_clock::now();
   while (loop.running() && !signals.requested()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));

@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "build_observer.h"
 #include "vrdeform/core/write_file.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
@@ -80,7 +81,8 @@ int soak(const SoakArgs& a) {
       "soak: scene {}, {} steps ({:.1f} s simulated); its {} hand actions repeated every {:g} s; warm-up {} "
       "steps\n",
       spec.name, a.steps, seconds, perRound, cycle, warm);
-  BuiltScene scene = buildScene(spec, [](std::string_view) {});
+  const StopSignals signals;
+  BuiltScene scene = buildScene(spec, commandObserver(signals, false));
 
   // Watched: resident memory and the step times' statistics per row of the table, the volume
   // loss at the end of each round (the hand away from the body), step times early and late.
@@ -90,7 +92,6 @@ int soak(const SoakArgs& a) {
   std::uint64_t nan = 0;
   fmt::print("\n{:>10} {:>10} {:>8} {:>9} {:>9} {:>13} {:>5}\n", "step", "time (s)", "RSS (MB)", "mean (ms)",
              "P99 (ms)", "volume loss %", "NaN");
-  const StopSignals signals;
   RunSettings settings;
   settings.steps = a.steps;
   settings.outDir = a.out;

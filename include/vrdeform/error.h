@@ -12,4 +12,11 @@ class Error : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A long operation (meshing, settling, calibrating) ended early because its caller asked, e.g.
+/// on Ctrl-C: not bad input. The message says where it stopped.
+class Stopped : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 }  // namespace vrd

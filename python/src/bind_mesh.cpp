@@ -131,11 +131,18 @@ void bindMesh(py::module_& m) {
           throw Error(fmt::format("mesher '{}': builtin or tetgen", mesher));
         options.targetTets = tets;
         options.maxVolume = maxVolume;
-        py::gil_scoped_release release;
-        return tetrahedralise(surface, options).mesh;
+        options.stop = ctrlC();
+        try {
+          py::gil_scoped_release release;
+          return tetrahedralise(surface, options).mesh;
+        } catch (const Stopped&) {
+          if (PyErr_Occurred()) throw py::error_already_set();  // the KeyboardInterrupt
+          throw;
+        }
       },
       py::arg("surface"), py::arg("tets") = 0, py::arg("mesher") = "builtin", py::arg("max_volume") = 0.0,
-      "Checks a closed surface and fills it with tets (about `tets` of them when given)");
+      "Checks a closed surface and fills it with tets (about `tets` of them when given); Ctrl-C stops it between the "
+      "mesher's runs");
 }
 
 }  // namespace vrd::python

@@ -8,7 +8,6 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
-#include <chrono>
 #include <cmath>
 #include <optional>
 
@@ -225,17 +224,19 @@ void bindScene(py::module_& m) {
             // Ctrl-C, the end of a Python hand, and an exception in the callback or the hand end the
             // run after the step in progress; the exception is raised once the run has stopped.
             std::optional<py::error_already_set> error;
-            auto lastCheck = std::chrono::steady_clock::now();
+            const auto interrupted = ctrlC();
             settings.afterStep = [&](const RunStep& s) {
               if (glove && s.session) glove->afterStep(s.session->haptics(), s.time);
               if (pythonHand && pythonHand->finished(s.step, s.time)) return false;
-              const auto now = std::chrono::steady_clock::now();
-              if (!callback && now - lastCheck < std::chrono::milliseconds(50)) return true;
-              lastCheck = now;
+              if (!callback) {
+                if (!interrupted()) return true;
+                py::gil_scoped_acquire gil;
+                error.emplace();  // the KeyboardInterrupt
+                return false;
+              }
               py::gil_scoped_acquire gil;
               try {
                 if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-                if (!callback) return true;
                 const py::object r = (*callback)(stepInfo(s));
                 return r.is_none() || r.cast<bool>();
               } catch (py::error_already_set& e) {
@@ -276,17 +277,24 @@ released while the solver runs; Ctrl-C stops the run after the step in progress.
   m.def(
       "build_scene",
       [](const SceneSpec& spec, bool verbose) {
-        SceneLog log;
+        SceneBuildObserver observer;
         if (verbose)
-          log = [](std::string_view line) {
+          observer.log = [](std::string_view line) {
             py::gil_scoped_acquire gil;
             py::print(std::string(line));
           };
-        py::gil_scoped_release release;
-        return buildScene(spec, log);
+        observer.stop = ctrlC();
+        try {
+          py::gil_scoped_release release;
+          return buildScene(spec, observer);
+        } catch (const Stopped&) {
+          if (PyErr_Occurred()) throw py::error_already_set();  // the KeyboardInterrupt
+          throw;
+        }
       },
       py::arg("spec"), py::arg("verbose") = false,
-      "Builds the scene: meshes its bodies, settles them and calibrates the haptics (as `vrdeform run` does)");
+      "Builds the scene: meshes its bodies, settles them and calibrates the haptics (as `vrdeform run` does); "
+      "Ctrl-C stops it with KeyboardInterrupt");
 }
 
 }  // namespace vrd::python

@@ -203,11 +203,12 @@ to add bodies; write through set_positions and set_velocities.)")
       .def(
           "steps",
           [](World& w, std::uint64_t n) {
+            const auto interrupted = ctrlC();
             for (std::uint64_t k = 0; k < n; ++k) {
               w.step();
-              if ((k & 63) == 63) {
+              if (interrupted()) {
                 py::gil_scoped_acquire gil;
-                if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+                throw py::error_already_set();  // the KeyboardInterrupt
               }
             }
           },

@@ -91,6 +91,16 @@ def test_ctrl_c_stops_a_long_run():
     timer.join()
 
 
+def test_ctrl_c_stops_settling():
+    spec = vrdeform.load_scene("liver")
+    spec.settle = 300.0
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        vrdeform.build_scene(spec)
+    timer.join()
+
+
 def test_a_scene_of_a_mesh_alone(tmp_path):
     meshes = pathlib.Path(vrdeform.load_scene("liver").source).parent.parent / "data" / "meshes"
     text = """

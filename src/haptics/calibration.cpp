@@ -77,6 +77,7 @@ HapticCalibration calibrateHaptics(const World& original, BodyId body, const Hap
   for (int k = 1; k <= loading + loading / 2; ++k) {
     world.moveFingertip(tip, start + std::min(1.0f, float(k) / float(loading)) * (end - start));
     world.step();
+    if (settings.stop && settings.stop()) throw Stopped("stopped while calibrating the haptics");
   }
   const float sag = down.dot(centroid(world, body) - before);
   if (sag > 0.5f * depth)

@@ -90,13 +90,18 @@ TetMesh runTetGen(const TriMesh& surface, double maxVolume, double radiusEdge, c
         fmt::format("cannot run TetGen ('{}': {}); install it (Debian package tetgen) or use the built-in mesher",
                     program, std::strerror(spawnError)));
 
-  // Wait, polling, so a hung TetGen is killed after the timeout.
+  // Wait, polling, so a hung TetGen is killed after the timeout, or when the caller stops.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(options.timeoutSeconds);
   int status = 0;
   for (;;) {
     const pid_t done = ::waitpid(pid, &status, WNOHANG);
     if (done == pid) break;
     if (done < 0 && errno != EINTR) throw Error(fmt::format("lost track of TetGen: {}", std::strerror(errno)));
+    if (options.stop && options.stop()) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      throw Stopped("stopped while meshing (TetGen stopped)");
+    }
     if (std::chrono::steady_clock::now() > deadline) {
       ::kill(pid, SIGKILL);
       ::waitpid(pid, &status, 0);

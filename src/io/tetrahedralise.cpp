@@ -44,7 +44,10 @@ Tetrahedralisation searchCount(Run&& run, double target, double initialBound, do
 
 Tetrahedralisation builtin(const TriMesh& surface, double volume, const TetrahedraliseOptions& options) {
   // A BCC lattice of cube edge h has tets of volume h^3 / 12.
-  auto run = [&](double bound) { return stuffIsosurface(surface, {std::cbrt(12 * bound), options.preserveVolume}); };
+  auto run = [&](double bound) {
+    if (options.stop && options.stop()) throw Stopped("stopped while meshing");
+    return stuffIsosurface(surface, {std::cbrt(12 * bound), options.preserveVolume});
+  };
   // Runs are cheap, so aim closer than the tolerance asks.
   if (options.targetTets > 0)
     return searchCount(run, double(options.targetTets), volume / double(options.targetTets),

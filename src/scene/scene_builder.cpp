@@ -55,7 +55,7 @@ Eigen::AlignedBox3f boundsOf(const std::vector<Vec3>& points) {
 
 }  // namespace
 
-PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log) {
+PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log, const std::function<bool()>& stop) {
   PlacedMesh out;
   const std::string name = fileName(body.mesh);
   if (body.kind == BodyKind::Cloth) {
@@ -68,7 +68,9 @@ PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log) {
     out.hash = meshHash(surface.vertices, surface.triangles);
     for (Vec3& v : surface.vertices) v *= body.scale;
     const auto start = std::chrono::steady_clock::now();
-    out.tets = tetrahedralise(surface, body.mesher).mesh;
+    TetrahedraliseOptions mesher = body.mesher;
+    mesher.stop = stop;
+    out.tets = tetrahedralise(surface, mesher).mesh;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     say(log,
         fmt::format("mesh: {} ({} triangles) x {:g}: {} tets from the {} mesher in {:.2f} s", name,
@@ -156,7 +158,9 @@ const SceneBody& BuiltScene::body(std::string_view name) const {
   throw Error(fmt::format("scene {}: no body named '{}'", spec.name, name));
 }
 
-BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log) {
+BuiltScene buildScene(const SceneSpec& spec, const SceneBuildObserver& observer) {
+  const SceneLog& log = observer.log;
+  const auto stopped = [&] { return observer.stop && observer.stop(); };
   BuiltScene scene;
   scene.spec = spec;
   if (spec.bodies.empty()) throw Error(fmt::format("scene {}: no bodies", spec.name));
@@ -168,7 +172,7 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log) {
     body.name = b.name;
     body.kind = b.kind;
     try {
-      body.mesh = placeBodyMesh(b, log);
+      body.mesh = placeBodyMesh(b, log, observer.stop);
       if (b.kind == BodyKind::Cloth) {
         body.model = makeCloth(body.mesh.surface, b.material);
       } else {
@@ -177,6 +181,8 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log) {
       }
     } catch (const Error& e) {
       throw Error(fmt::format("body '{}': {}", b.name, e.what()));
+    } catch (const Stopped& e) {
+      throw Stopped(fmt::format("{} body '{}'", e.what(), b.name));
     }
     body.id = world.addBody(body.model);
     const Vec3 wind = b.kind == BodyKind::Cloth ? spec.wind : Vec3::Zero();
@@ -203,7 +209,13 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log) {
   for (const Collider& c : spec.colliders) world.addCollider(c);
 
   const long settleSteps = std::lround(spec.settle / double(spec.solver.timeStep));
-  for (long k = 0; k < settleSteps; ++k) world.step();
+  for (long k = 1; k <= settleSteps; ++k) {
+    world.step();
+    if (observer.settling) observer.settling(double(k) * spec.solver.timeStep, spec.settle);
+    if (stopped())
+      throw Stopped(
+          fmt::format("stopped while settling, {:.2f} s of {:g} s", double(k) * spec.solver.timeStep, spec.settle));
+  }
   scene.settleSeconds = double(settleSteps) * spec.solver.timeStep;
   scene.settleEvents = world.takeEvents();
   for (const SimEvent& e : scene.settleEvents) say(log, fmt::format("event while settling: {}", e.message));
@@ -249,6 +261,7 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log) {
     c.contact = hand.rig.contact;
     c.friction = hand.rig.friction;
     c.point = body->top;
+    c.stop = observer.stop;
     if (!hand.actions.empty()) {
       const ActionSpec& first = hand.actions.front();
       body = first.body.empty() ? body : &scene.body(first.body);

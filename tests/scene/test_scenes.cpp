@@ -366,6 +366,40 @@ TEST(SceneBuilder, AGiantBodyGetsAWarningAboutUnits) {
   EXPECT_NE(warning->find("scale = 0.001 makes it 0.19"), std::string::npos) << *warning;
 }
 
+// The observer's stop ends each phase of a build where it is, saying where: the caller's Ctrl-C.
+TEST(SceneBuilder, StopsWhileMeshingSettlingOrCalibrating) {
+  const auto stoppedAt = [](SceneSpec spec, int polls, std::vector<std::pair<double, double>>* settled = nullptr) {
+    SceneBuildObserver o;
+    o.stop = [polls, n = 0]() mutable { return ++n > polls; };
+    if (settled) o.settling = [settled](double done, double total) { settled->emplace_back(done, total); };
+    try {
+      buildScene(spec, o);
+    } catch (const Stopped& e) {
+      return std::string(e.what());
+    }
+    return std::string("not stopped");
+  };
+  SceneSpec liver = loadSceneByName("liver");  // a surface, meshed by the built-in mesher
+  EXPECT_EQ(stoppedAt(liver, 0), "stopped while meshing body 'liver'");
+  std::vector<std::pair<double, double>> settled;
+  const std::string settling = stoppedAt(liver, 30, &settled);
+  EXPECT_EQ(settling.rfind("stopped while settling, ", 0), 0u) << settling;
+  ASSERT_FALSE(settled.empty());
+  EXPECT_DOUBLE_EQ(settled.back().second, liver.settle);
+  for (std::size_t k = 1; k < settled.size(); ++k) EXPECT_GT(settled[k].first, settled[k - 1].first);
+  // Five steps into the calibration's poke, once settling is done.
+  SceneBuildObserver o;
+  bool settledAll = false;
+  o.settling = [&](double done, double total) { settledAll = done >= total - 1e-9; };
+  o.stop = [&, after = 0]() mutable { return settledAll && ++after > 5; };
+  try {
+    buildScene(liver, o);
+    ADD_FAILURE() << "not stopped";
+  } catch (const Stopped& e) {
+    EXPECT_STREQ(e.what(), "stopped while calibrating the haptics");
+  }
+}
+
 TEST(SceneLibrary, UnknownNamesListTheBuiltInScenes) {
   const std::string e = testing::errorOf([] { loadSceneByName("livr"); });
   EXPECT_NE(e.find("no built-in scene 'livr'"), std::string::npos) << e;

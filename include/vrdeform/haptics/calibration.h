@@ -11,6 +11,7 @@
 // tau^S (in the ratio of their inverse-distance-weighted means around the fingertip) are scaled
 // so that F_VS equals `volumeStrainTarget`.
 
+#include <functional>
 #include <optional>
 
 #include "vrdeform/haptics/haptic_signal.h"
@@ -29,7 +30,8 @@ struct CalibrationSettings {
   /// feels deeper (the standard poke reads 0.45 with the default betas).
   float contactTarget = 0.5f;
   float volumeStrainTarget = 0.4f;
-  std::optional<Vec3> point;  ///< poke this surface point instead of the highest particle
+  std::optional<Vec3> point;        ///< poke this surface point instead of the highest particle
+  std::function<bool()> stop = {};  ///< polled after each step of the poke: true ends it with vrd::Stopped
 };
 
 struct HapticCalibration {

@@ -4,6 +4,7 @@
 // separate program, so its licence stays apart from ours and a crash of it cannot take us down.
 
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include "vrdeform/mesh/tet_mesh.h"
@@ -28,6 +29,9 @@ struct TetrahedraliseOptions {
   bool preserveVolume = true;            ///< built-in: see StuffingOptions
   std::string tetgenProgram = "tetgen";  ///< name in PATH, or a path
   double timeoutSeconds = 300;           ///< per TetGen run
+  /// Polled before each run of the mesher and while TetGen runs: true ends meshing with vrd::Stopped
+  /// (TetGen killed). Empty: never.
+  std::function<bool()> stop = {};
 };
 
 struct Tetrahedralisation {

@@ -22,6 +22,16 @@ namespace vrd {
 /// Progress messages while building ("mesh: ...", "settled ..."); may be empty.
 using SceneLog = std::function<void(std::string_view)>;
 
+/// What a caller sees of buildScene while it works, and how it stops it (each member may be empty).
+struct SceneBuildObserver {
+  SceneLog log;
+  /// After each settling step: the seconds settled and the seconds to settle.
+  std::function<void(double done, double total)> settling;
+  /// Polled before each run of the mesher, while TetGen runs, after each settling step and each
+  /// step of the calibration poke: true ends the build with vrd::Stopped, saying where.
+  std::function<bool()> stop;
+};
+
 /// A body's mesh as read, in the scene's placement.
 struct PlacedMesh {
   TetMesh tets;            ///< soft bodies: the tets; cloth: the vertices only
@@ -31,8 +41,9 @@ struct PlacedMesh {
 };
 
 /// Reads `body.mesh` (a surface is tetrahedralised for a soft body), scales, rotates and places it
-/// as the spec says, and the render mesh with it. Throws vrd::Error naming the file.
-PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log = {});
+/// as the spec says, and the render mesh with it. Throws vrd::Error naming the file, vrd::Stopped
+/// when `stop` asks while meshing.
+PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log = {}, const std::function<bool()>& stop = {});
 
 /// The bounding box of a body's particles where they are now.
 Eigen::AlignedBox3f bodyBounds(const World& world, BodyId body);
@@ -66,7 +77,11 @@ struct BuiltScene {
 };
 
 /// Builds and settles the scene. Throws vrd::Error (naming the body or file) on bad input, a body
-/// that does not settle to finite positions, or a failed calibration.
-BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log = {});
+/// that does not settle to finite positions, or a failed calibration; vrd::Stopped when the
+/// observer's stop asks.
+BuiltScene buildScene(const SceneSpec& spec, const SceneBuildObserver& observer);
+inline BuiltScene buildScene(const SceneSpec& spec, const SceneLog& log = {}) {
+  return buildScene(spec, SceneBuildObserver{log, {}, {}});
+}
 
 }  // namespace vrd

@@ -1,0 +1,32 @@
+#!/bin/sh
+# Ctrl-C while a scene settles: `vrdeform run` stops within half a second, says where it stopped
+# and exits with status 130.
+# Usage: stop_while_settling.sh VRDEFORM MESHES_DIR SCRATCH_DIR
+set -u
+vrdeform=$1 meshes=$2 dir=$3
+mkdir -p "$dir"
+cat > "$dir/slow.toml" <<TOML
+format = 1
+name = "slow"
+settle = 300.0
+[solver]
+substeps = 20
+[[body]]
+mesh = "$meshes/sphere_coarse.obj"
+scale = 0.05
+[hand]
+enabled = false
+TOML
+"$vrdeform" run "$dir/slow.toml" > "$dir/out.txt" 2>&1 &
+pid=$!
+sleep 2
+kill -INT $pid
+sent=$(date +%s%N)
+wait $pid
+status=$?
+ms=$((($(date +%s%N) - sent) / 1000000))
+cat "$dir/out.txt"
+[ $status -eq 130 ] || { echo "FAIL: exit status $status, not 130"; exit 1; }
+[ $ms -le 500 ] || { echo "FAIL: took $ms ms to stop"; exit 1; }
+grep -q "stopped while settling" "$dir/out.txt" || { echo "FAIL: does not say where it stopped"; exit 1; }
+echo "PASS: stopped in $ms ms"
