@@ -95,7 +95,10 @@ void bindScene(py::module_& m) {
       .def_readwrite("description", &SceneSpec::description)
       .def_readonly("source", &SceneSpec::source)
       .def_readwrite("solver", &SceneSpec::solver)
-      .def_readwrite("settle", &SceneSpec::settle, "s the bodies settle before the interaction")
+      .def_readwrite("settle", &SceneSpec::settle,
+                     "s the bodies settle before the interaction (the most, with settle_to_rest)")
+      .def_readwrite("settle_to_rest", &SceneSpec::settleToRest,
+                     "settling ends once every particle is slower than 5 mm/s (a scene file without settle)")
       .def_readwrite("seconds", &SceneSpec::seconds, "default length of a run (s)")
       .def_property(
           "hand_enabled", [](const SceneSpec& s) { return s.hand.enabled; },

@@ -208,22 +208,39 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneBuildObserver& observer)
   }
   for (const Collider& c : spec.colliders) world.addCollider(c);
 
-  const long settleSteps = std::lround(spec.settle / double(spec.solver.timeStep));
-  for (long k = 1; k <= settleSteps; ++k) {
+  const double dt = spec.solver.timeStep;
+  const long settleSteps = std::lround(spec.settle / dt), leastSteps = std::lround(0.5 / dt),
+             stillSteps = std::max(1L, std::lround(0.2 / dt));
+  long steps = 0, still = 0;
+  float fastest = 0.0f;
+  while (steps < settleSteps) {
     world.step();
-    if (observer.settling) observer.settling(double(k) * spec.solver.timeStep, spec.settle);
+    ++steps;
+    if (observer.settling) observer.settling(double(steps) * dt, spec.settle);
     if (stopped())
-      throw Stopped(
-          fmt::format("stopped while settling, {:.2f} s of {:g} s", double(k) * spec.solver.timeStep, spec.settle));
+      throw Stopped(fmt::format("stopped while settling, {:.2f} s of {:g} s", double(steps) * dt, spec.settle));
+    if (!spec.settleToRest) continue;
+    fastest = 0.0f;
+    for (std::size_t i = 0; i < world.particles().size(); ++i)
+      if (world.particles().x[i].w > 0.0f) fastest = std::max(fastest, world.particles().v[i].norm());
+    still = fastest < SceneSpec::kRestSpeed ? still + 1 : 0;
+    if (steps >= leastSteps && still >= stillSteps) break;
   }
-  scene.settleSeconds = double(settleSteps) * spec.solver.timeStep;
+  scene.settleSeconds = double(steps) * dt;
   scene.settleEvents = world.takeEvents();
   for (const SimEvent& e : scene.settleEvents) say(log, fmt::format("event while settling: {}", e.message));
   for (SceneBody& b : scene.bodies) {
     b.top = topPoint(world, b.id);
     if (!isFinite(b.top)) throw Error(fmt::format("body '{}' did not settle to finite positions", b.name));
   }
-  say(log, fmt::format("settled for {:g} s", scene.settleSeconds));
+  if (!spec.settleToRest)
+    say(log, fmt::format("settled for {:g} s", scene.settleSeconds));
+  else if (steps < settleSteps)
+    say(log, fmt::format("settled for {:.2f} s: at rest", scene.settleSeconds));
+  else
+    say(log, fmt::format("settled for {:.2f} s: still moving at up to {:.3f} m/s (`settle = SECONDS` in the scene "
+                         "file settles as long as it says)",
+                         scene.settleSeconds, fastest));
 
   const HandSpec& hand = spec.hand;
   scene.session.hand = hand.rig;

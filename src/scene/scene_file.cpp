@@ -25,6 +25,12 @@
 namespace vrd {
 namespace {
 
+// Scene files' defaults where the library keeps the paper's: 8 substeps (at the paper's 1 a soft
+// body settling under gravity loses several percent of its volume, and more), and soft tissue (the
+// liver's) for a soft body whose material gives neither moduli nor compliances.
+constexpr int kSceneSubsteps = 8;
+constexpr ElasticModuli kSoftTissue{3.0e4f, 0.45f, 1060.0f, 0.005f};
+
 namespace fs = std::filesystem;
 using Line = toml::source_index;
 using Keys = std::vector<std::string_view>;
@@ -389,6 +395,7 @@ SolverSettings readSolver(const Table& t) {
                "fuse_strain_volume", "measure_residuals", "tolerance", "warm_start"});
   t.exclusive("rate", "dt");
   SolverSettings s;
+  s.substeps = kSceneSubsteps;
   if (std::optional<Field> f = t.get("rate")) s.timeStep = 1.0 / double(f->integer(1, 100000));
   t.readNumber("dt", s.timeStep, kPositive);
   t.readInt("substeps", s.substeps, 1, 1000);
@@ -441,6 +448,16 @@ void readMass(const Table& t, BodyKind kind, Material& m) {
   if (std::optional<Field> f = t.get("particle_mass")) m.particleMass = f->number<float>(kPositive);
 }
 
+// A soft body whose material table gives neither moduli nor the paper's compliance form: soft
+// tissue (as the liver's), so that a scene of a mesh alone weighs and deforms as a body would.
+bool takesSoftTissue(const Table& t, BodyKind kind) {
+  if (kind != BodyKind::Soft) return false;
+  for (std::string_view key : {"youngs", "poisson", "compliance", "damping", "particle_mass", "distance", "volume",
+                               "strain_stretch", "strain_shear", "shape_matching", "bending"})
+    if (t.has(key)) return false;
+  return true;
+}
+
 Material readMaterial(const Table& t, BodyKind kind) {
   static constexpr Option<ConstraintMaterial Material::*> kTypes[] = {{"distance", &Material::distance},
                                                                       {"volume", &Material::volume},
@@ -454,7 +471,13 @@ Material readMaterial(const Table& t, BodyKind kind) {
   t.allowOnly(keys);
 
   Material m;
-  readModuli(t, kind, m);
+  if (takesSoftTissue(t, kind)) {
+    m.elastic = kSoftTissue;
+    t.readNumber("density", m.elastic->density, kPositive);
+    t.readNumber("rayleigh_damping", m.elastic->rayleighDamping, kNonNegative);
+  } else {
+    readModuli(t, kind, m);
+  }
   readMass(t, kind, m);
   // The blanket values first, so that a type's own table overrides them.
   if (std::optional<Field> f = t.get("compliance"))
@@ -708,6 +731,9 @@ SceneSpec readScene(const Table& root, std::string_view sourceName) {
   scene.name = fs::path(sourceName).stem().string();
   if (std::optional<Field> f = root.get("name")) scene.name = f->name();
   root.readString("description", scene.description);
+  // Until the bodies are at rest (at most kSettleToRestMost s) unless the file says how long.
+  scene.settleToRest = !root.has("settle");
+  scene.settle = scene.settleToRest ? SceneSpec::kSettleToRestMost : scene.settle;
   root.readNumber("settle", scene.settle, kNonNegative);
   root.readNumber("seconds", scene.seconds, kPositive);
   root.readVec3("wind", scene.wind);

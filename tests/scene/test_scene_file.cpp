@@ -197,6 +197,7 @@ TEST(SceneFile, FullSceneSetsEveryField) {
   EXPECT_EQ(s.description, "A liver poked and a flag pinched");
   EXPECT_EQ(s.source, "scene.toml");
   EXPECT_EQ(s.settle, 0.5);
+  EXPECT_FALSE(s.settleToRest);
   EXPECT_EQ(s.seconds, 3.0);
   EXPECT_EQ(s.wind, Vec3(20, 0, 1.5f));
 
@@ -352,11 +353,12 @@ TEST(SceneFile, AbsentKeysKeepTheirDefaults) {
   const SceneSpec d;
   EXPECT_EQ(s.name, "scene");  // the file's stem
   EXPECT_EQ(s.description, "");
-  EXPECT_EQ(s.settle, 1.0);
+  EXPECT_TRUE(s.settleToRest);  // until at rest, at most:
+  EXPECT_EQ(s.settle, SceneSpec::kSettleToRestMost);
   EXPECT_EQ(s.seconds, 6.0);
   EXPECT_EQ(s.wind, Vec3::Zero());
   EXPECT_EQ(s.solver.timeStep, d.solver.timeStep);
-  EXPECT_EQ(s.solver.substeps, d.solver.substeps);
+  EXPECT_EQ(s.solver.substeps, 8);  // the scenes' default: the paper's 1 loses volume while settling
   EXPECT_EQ(s.solver.iterations, d.solver.iterations);
   EXPECT_EQ(s.solver.gravity, d.solver.gravity);
   EXPECT_EQ(s.solver.simd, SimdLevel::Best);
@@ -380,11 +382,13 @@ TEST(SceneFile, AbsentKeysKeepTheirDefaults) {
   EXPECT_EQ(b.constraints.volume, paper.volume);
   EXPECT_EQ(b.constraints.strain, paper.strain);
   EXPECT_EQ(b.constraints.shapeMatching, paper.shapeMatching);
-  EXPECT_FALSE(b.material.elastic.has_value());
+  ASSERT_TRUE(b.material.elastic.has_value());  // soft tissue
+  EXPECT_EQ(b.material.elastic->youngsModulus, 3.0e4f);
+  EXPECT_EQ(b.material.elastic->poissonRatio, 0.45f);
+  EXPECT_EQ(b.material.elastic->density, 1060.0f);
+  EXPECT_EQ(b.material.elastic->rayleighDamping, 0.005f);
   EXPECT_FALSE(b.material.particleMass.has_value());  // masses from the density
-  EXPECT_EQ(b.material.density, Material().density);
-  EXPECT_EQ(b.material.volume.compliance, Material().volume.compliance);
-  ASSERT_EQ(s.colliders.size(), 1u);  // the ground
+  ASSERT_EQ(s.colliders.size(), 1u);                  // the ground
   EXPECT_EQ(s.colliders[0].shape, ColliderShape::Plane);
   EXPECT_EQ(s.colliders[0].normal, Vec3::UnitY());
   EXPECT_EQ(s.colliders[0].center, Vec3::Zero());
@@ -599,9 +603,14 @@ TEST(SceneFile, ModuliGoTogether) {
 }
 
 TEST(SceneFile, MassesComeFromADensityOrAParticleMass) {
+  // Soft tissue of another density; the paper's compliance form with a density.
   const Material soft = parse(std::string(kMinimal) + "[body.material]\ndensity = 500\n").bodies[0].material;
-  EXPECT_FALSE(soft.elastic.has_value());
-  EXPECT_FLOAT_EQ(soft.density, 500.0f);
+  ASSERT_TRUE(soft.elastic.has_value());
+  EXPECT_FLOAT_EQ(soft.elastic->density, 500.0f);
+  const Material paper =
+      parse(std::string(kMinimal) + "[body.material]\ndensity = 500\ncompliance = 0.3\n").bodies[0].material;
+  EXPECT_FALSE(paper.elastic.has_value());
+  EXPECT_FLOAT_EQ(paper.density, 500.0f);
   const std::string cloth = "[[body]]\nkind = \"cloth\"\nmesh = \"flag_plane.obj\"\n[body.material]\n";
   EXPECT_FLOAT_EQ(parse(cloth + "areal_density = 0.3\n").bodies[0].material.arealDensity, 0.3f);
   EXPECT_EQ(errorIn(cloth + "density = 500\n"),

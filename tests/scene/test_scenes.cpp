@@ -366,6 +366,21 @@ TEST(SceneBuilder, AGiantBodyGetsAWarningAboutUnits) {
   EXPECT_NE(warning->find("scale = 0.001 makes it 0.19"), std::string::npos) << *warning;
 }
 
+// A scene file without `settle` settles until every particle is slower than 5 mm/s; with it, as
+// long as it says.
+TEST(SceneBuilder, ASceneFileWithoutSettleSettlesToRest) {
+  const std::string body = "[[body]]\nmesh = \"sphere_coarse.obj\"\nscale = 0.03\n[hand]\nenabled = false\n";
+  SceneSpec spec = parseScene(body, "rest.toml", VRDEFORM_SHARED_DIR "/data/meshes");
+  std::vector<std::string> log;
+  BuiltScene scene = buildScene(spec, [&](std::string_view line) { log.emplace_back(line); });
+  EXPECT_GE(scene.settleSeconds, 0.5);
+  EXPECT_LT(scene.settleSeconds, SceneSpec::kSettleToRestMost);
+  for (const Vec3& v : scene.world->particles().v) EXPECT_LT(v.norm(), SceneSpec::kRestSpeed);
+  EXPECT_TRUE(std::any_of(log.begin(), log.end(), [](const std::string& l) { return l.ends_with(": at rest"); }));
+  spec = parseScene("settle = 0.3\n" + body, "fixed.toml", VRDEFORM_SHARED_DIR "/data/meshes");
+  EXPECT_DOUBLE_EQ(buildScene(spec).settleSeconds, std::round(0.3 * 60) / 60);
+}
+
 // The observer's stop ends each phase of a build where it is, saying where: the caller's Ctrl-C.
 TEST(SceneBuilder, StopsWhileMeshingSettlingOrCalibrating) {
   const auto stoppedAt = [](SceneSpec spec, int polls, std::vector<std::pair<double, double>>* settled = nullptr) {

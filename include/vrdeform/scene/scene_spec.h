@@ -79,8 +79,13 @@ struct SceneSpec {
   /// Constant acceleration (m/s^2: N per kg of each particle's mass) of every cloth particle; the
   /// paper's flag: 20 N on each 1 kg particle.
   Vec3 wind = Vec3::Zero();
-  double settle = 1.0;   ///< s the bodies settle under gravity before the interaction (not in the run's time)
-  double seconds = 6.0;  ///< default length of a run after settling
+  double settle = 1.0;  ///< s the bodies settle under gravity before the interaction (not in the run's time)
+  /// Settling ends once every particle has moved slower than kRestSpeed for 0.2 s (after at least
+  /// 0.5 s), `settle` being then the most it takes. Scene files settle so unless they give `settle`.
+  bool settleToRest = false;
+  static constexpr double kRestSpeed = 0.005;        ///< m/s
+  static constexpr double kSettleToRestMost = 20.0;  ///< s, a scene file's `settle` when it gives none
+  double seconds = 6.0;                              ///< default length of a run after settling
   std::vector<BodySpec> bodies;
   std::vector<Collider> colliders;  ///< the ground is one, if wanted
   HandSpec hand;
