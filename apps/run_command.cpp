@@ -24,7 +24,7 @@ namespace vrd {
 namespace {
 
 struct RunArgs {
-  std::string scene, out, weart, osc, forces;
+  std::string scene, out, weart, osc, forces, record, replay;
   double seconds = 0.0;  // 0: the scene's
   std::uint64_t steps = 0;
   int substeps = 0, iterations = 0;  // 0: the scene's
@@ -171,13 +171,33 @@ class Progress {
   bool hand_;
 };
 
-int run(const RunArgs& a) {
+// What a recording of `vrdeform run` keeps to run again: the scene as named and the solver's overrides.
+constexpr std::string_view kRecordedSolver[] = {"substeps", "iterations"};
+
+int run(RunArgs a) {
   if (a.render && a.out.empty()) throw Error("--render needs --out DIR for the frames");
+  std::optional<SessionRecording> replaying;
+  if (!a.replay.empty()) {
+    if (!a.record.empty() || !a.weart.empty()) throw Error("--replay cannot go with --record or --weart");
+    replaying = SessionRecording::load(a.replay);
+    const std::string* tool = replaying->setting("tool");
+    if (!tool || *tool != "run") throw Error(fmt::format("{}: not a recording of `vrdeform run`", a.replay));
+    const std::string* scene = replaying->setting("scene");
+    if (!scene) throw Error(fmt::format("{}: no scene setting", a.replay));
+    if (a.scene.empty()) a.scene = *scene;
+    for (std::string_view key : kRecordedSolver)
+      if (const std::string* v = replaying->setting(key); v && *v != "0")
+        (key == "substeps" ? a.substeps : a.iterations) = std::stoi(*v);
+    a.steps = std::max<std::size_t>(1, replaying->steps.size());
+  }
+  if (a.scene.empty()) throw Error("run: a SCENE is needed (or --replay FILE)");
   if (!a.out.empty()) prepareOutputFolder(a.out);
   SceneSpec spec = loadSceneByName(a.scene);
   if (a.substeps > 0) spec.solver.substeps = a.substeps;
   if (a.iterations > 0) spec.solver.iterations = a.iterations;
   validateSolverSettings(spec.solver);
+  if ((replaying || !a.record.empty()) && !spec.hand.enabled)
+    throw Error(fmt::format("scene {} has no hand to record or replay", spec.name));
   fmt::print("scene {}: {}\n  from {}\n", spec.name, spec.description, spec.source);
   const StopSignals signals;  // from here on Ctrl-C stops what runs: meshing, settling, calibrating, the run
   BuiltScene scene = buildScene(spec, commandObserver(signals));
@@ -209,6 +229,30 @@ int run(const RunArgs& a) {
   }
   for (const auto& o : outputs) settings.outputs.push_back(o.get());
   if (glove) settings.input = &glove->input();
+  // --record: every step's hand and outputs, written as the run goes; --replay: the recorded hand,
+  // each step's outputs checked against the recorded ones bit for bit.
+  std::optional<SessionRecordingWriter> recorder;
+  if (!a.record.empty()) {
+    recorder.emplace(a.record,
+                     std::vector<std::pair<std::string, std::string>>{{"tool", "run"},
+                                                                      {"scene", a.scene},
+                                                                      {"substeps", std::to_string(a.substeps)},
+                                                                      {"iterations", std::to_string(a.iterations)}});
+    settings.record = [&](const RecordedStep& step) { recorder->add(step); };
+  }
+  std::optional<RecordingInput> replayInput;
+  std::string difference;
+  std::uint64_t replayed = 0;
+  if (replaying) {
+    replayInput.emplace(std::move(*replaying));
+    settings.input = &*replayInput;
+    settings.record = [&](const RecordedStep& step) {
+      const std::vector<RecordedStep>& recorded = replayInput->recording().steps;
+      if (difference.empty() && replayed < recorded.size())
+        difference = replayDifference(replayed, recorded[replayed].outputs, step.outputs);
+      ++replayed;
+    };
+  }
   std::optional<SceneVideo> video;
   if (a.render) {
     try {
@@ -223,7 +267,7 @@ int run(const RunArgs& a) {
     progress.step(s);
     if (video) video->afterStep(s);
     if (glove && s.session) glove->afterStep(s.session->haptics(), s.time);
-    return !signals.requested();
+    return !signals.requested() && difference.empty();
   };
   RunSummary summary;
   try {
@@ -246,6 +290,15 @@ int run(const RunArgs& a) {
     for (const auto& f : summary.files) fmt::print(" {}", f.generic_string());
     fmt::print("\n");
   }
+  if (recorder) {
+    recorder->finish();
+    fmt::print("recorded {} steps into {}\n", recorder->steps(), a.record);
+  }
+  if (!difference.empty()) {
+    fmt::print("replay: {}\n", difference);
+    return 1;
+  }
+  if (replayInput) fmt::print("replay: {} steps, identical\n", replayed);
   return 0;
 }
 
@@ -264,7 +317,8 @@ int listScenes() {
 std::function<int()> addRunCommands(CLI::App& app) {
   auto a = std::make_shared<RunArgs>();
   CLI::App* run = app.add_subcommand("run", "Simulate a scene headless; print a summary; write outputs with --out");
-  run->add_option("scene", a->scene, "A built-in scene (`vrdeform scenes`) or a scene file (.toml)")->required();
+  run->add_option("scene", a->scene,
+                  "A built-in scene (`vrdeform scenes`) or a scene file (.toml); with --replay, the recording's");
   auto* seconds = run->add_option("--seconds", a->seconds, "Simulated time after settling (default: the scene's)")
                       ->check(CLI::Range(1e-6, 1e9));
   run->add_option("--steps", a->steps, "Number of steps instead of --seconds")
@@ -283,6 +337,10 @@ std::function<int()> addRunCommands(CLI::App& app) {
       ->check(CLI::Validator(weartEndpointError, "HOST[:PORT]"));
   run->add_option("--forces", a->forces, "Log every step's per-finger forces with timestamps to this CSV file");
   run->add_option("--osc", a->osc, "Send every step's forces as OSC over UDP to HOST:PORT (docs/outputs.md)");
+  run->add_option("--record", a->record,
+                  "Record the hand of every step and its outputs into this file as the run goes (docs/hand-input.md)");
+  run->add_option("--replay", a->replay,
+                  "Run a recording's scene again with its recorded hand and check every step's outputs bit for bit");
   run->add_flag("--render", a->render,
                 "Also draw the run headless into --out: frames/frame_NNNNN.png, and video.mp4 when ffmpeg is on PATH");
   addVideoOptions(*run, a->video);

@@ -292,14 +292,6 @@ HandAction standardPoke(const Vec3& top, float radius) {
 
 // --- Output --------------------------------------------------------------------------------------
 
-std::string outputName(std::size_t j) {
-  if (j == 0) return "paper";
-  if (j == 1) return "paper raw";
-  constexpr std::array<const char*, 4> kinds{"force", "raw", "newtons", "baseline"};
-  if (j - 2 < std::size_t(4 * kFingerCount)) return fmt::format("{} {}", kFingerNames[(j - 2) / 4], kinds[(j - 2) % 4]);
-  return fmt::format("output {}", j);
-}
-
 // Steps of `dt` in `seconds`, at least 1 (and no overflow for huge values).
 std::uint64_t steps(double seconds, double dt) {
   const double n = std::round(seconds / dt);
@@ -564,22 +556,8 @@ int replay(const TouchArgs& a, const std::string& version, bool sceneOptionsGive
   std::string difference;
   const Tally tally = drive(session, input, stepCap(a.seconds, s.rate), a.reportEvery, nullptr,
                             csv ? &csv->stream() : nullptr, [&](std::uint64_t k) {
-                              const std::vector<float> now = recordedOutputs(session.haptics());
-                              const std::vector<float>& then = steps[k].outputs;
-                              if (now.size() != then.size()) {
-                                difference = fmt::format("replay: differs at step {} (output count: {} vs {})", k,
-                                                         then.size(), now.size());
-                                return false;
-                              }
-                              for (std::size_t j = 0; j < now.size(); ++j)
-                                if (std::memcmp(&now[j], &then[j], sizeof(float)) != 0) {
-                                  difference = fmt::format(
-                                      "replay: differs at step {} (output {}: {} vs {})\n  output {} is {}; recorded "
-                                      "value first, replayed second ({:.9g} vs {:.9g})",
-                                      k, j, hexFloat(then[j]), hexFloat(now[j]), j, outputName(j), then[j], now[j]);
-                                  return false;
-                                }
-                              return true;
+                              difference = replayDifference(k, steps[k].outputs, recordedOutputs(session.haptics()));
+                              return difference.empty();
                             });
   printSummary(tally, session.rig(), 1.0 / s.rate);
   if (csv) {
@@ -587,7 +565,7 @@ int replay(const TouchArgs& a, const std::string& version, bool sceneOptionsGive
     fmt::print("wrote {}\n", a.csv);
   }
   if (!difference.empty()) {
-    fmt::print("{}\n", difference);
+    fmt::print("replay: {}\n", difference);
     return 1;
   }
   if (tally.steps == recorded)

@@ -1,5 +1,10 @@
 #include "vrdeform/haptics/haptic_session.h"
 
+#include <fmt/format.h>
+
+#include <array>
+#include <cstring>
+
 namespace vrd {
 
 HapticSession::HapticSession(World& world, const HapticSessionSettings& settings, const HandFrame& initial)
@@ -49,6 +54,28 @@ std::vector<float> recordedOutputs(const HapticFrame& frame) {
   std::vector<float> out{frame.paper, frame.paperRaw};
   for (const FingerHaptics& f : frame.fingers) out.insert(out.end(), {f.force, f.raw, f.newtons, f.baseline});
   return out;
+}
+
+std::string recordedOutputName(std::size_t j) {
+  if (j == 0) return "paper";
+  if (j == 1) return "paper raw";
+  constexpr std::array<const char*, kFingerCount> fingers{"thumb", "index", "middle", "ring", "little"};
+  constexpr std::array<const char*, 4> kinds{"force", "raw", "newtons", "baseline"};
+  if (j - 2 < std::size_t(4 * kFingerCount)) return fmt::format("{} {}", fingers[(j - 2) / 4], kinds[(j - 2) % 4]);
+  return fmt::format("output {}", j);
+}
+
+std::string replayDifference(std::uint64_t step, const std::vector<float>& recorded,
+                             const std::vector<float>& replayed) {
+  if (recorded.size() != replayed.size())
+    return fmt::format("differs at step {} (output count: {} vs {})", step, recorded.size(), replayed.size());
+  for (std::size_t j = 0; j < recorded.size(); ++j)
+    if (std::memcmp(&recorded[j], &replayed[j], sizeof(float)) != 0)
+      return fmt::format(
+          "differs at step {} (output {}: {:a} vs {:a})\n  output {} is {}; recorded value first, replayed second "
+          "({:.9g} vs {:.9g})",
+          step, j, double(recorded[j]), double(replayed[j]), j, recordedOutputName(j), recorded[j], replayed[j]);
+  return "";
 }
 
 }  // namespace vrd

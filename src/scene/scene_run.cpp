@@ -250,7 +250,9 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
       const double t = double(k + 1) * summary.dt;
       bool contact = false;
       if (session) {
-        session->step(input ? input->frame(k, double(k) * summary.dt) : HandFrame{});
+        const HandFrame frame = input ? input->frame(k, double(k) * summary.dt) : HandFrame{};
+        session->step(frame);
+        if (settings.record) settings.record({frame, recordedOutputs(session->haptics())});
         contact = session->inContact();
       } else {
         world.step();

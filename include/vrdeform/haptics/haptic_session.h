@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "vrdeform/haptics/haptic_model.h"
@@ -57,5 +58,11 @@ class HapticSession {
 /// The values a recording keeps per step, in this order: paper, paperRaw, then per finger force,
 /// raw, newtons, baseline.
 std::vector<float> recordedOutputs(const HapticFrame& frame);
+/// What output j of recordedOutputs is: "paper", "paper raw", "index newtons", ...
+std::string recordedOutputName(std::size_t j);
+/// A replay's check of step `step`: "" when its outputs equal the recorded ones bit for bit, else
+/// "differs at step K (output J: RECORDED vs REPLAYED)" with both in hexadecimal and in decimal.
+std::string replayDifference(std::uint64_t step, const std::vector<float>& recorded,
+                             const std::vector<float>& replayed);
 
 }  // namespace vrd

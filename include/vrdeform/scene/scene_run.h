@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "vrdeform/devices/haptic_output.h"
+#include "vrdeform/interact/session_recording.h"
 #include "vrdeform/metrics/latency_stats.h"
 #include "vrdeform/metrics/signal_quality.h"
 #include "vrdeform/scene/scene_builder.h"
@@ -36,6 +37,9 @@ struct RunSettings {
   std::vector<HapticOutput*> outputs;  ///< also receive every step's signal (OSC, a CSV log, ...)
   /// Called after every step; returning false ends the run there (Ctrl-C, a real-time pace).
   std::function<bool(const RunStep&)> afterStep;
+  /// In a scene with a hand, called after every step with the hand the step consumed and its
+  /// recordedOutputs, before afterStep: a SessionRecordingWriter's add for `vrdeform run --record`.
+  std::function<void(const RecordedStep&)> record;
 };
 
 /// The signal of one of the scene's scripted pokes, from its start to 0.3 s after its release.
