@@ -33,6 +33,7 @@ def test_a_glove_that_is_not_there_is_reported_and_the_run_goes_on():
     news = []
     summary = scene.run(steps=20, weart=f"127.0.0.1:{port}", glove_news=lambda line, error: news.append((line, error)))
     assert summary["steps"] == 20
+    assert any(error and "cannot connect" in line for line, error in news), news
     with pytest.raises(vrdeform.Error, match="port"):
         scene.run(steps=1, weart="127.0.0.1:99999")
 
