@@ -26,9 +26,11 @@ namespace vrd {
 namespace {
 
 // Scene files' defaults where the library keeps the paper's: 8 substeps (at the paper's 1 a soft
-// body settling under gravity loses several percent of its volume, and more), and soft tissue (the
-// liver's) for a soft body whose material gives neither moduli nor compliances.
+// body settling under gravity loses several percent of its volume, and more); fingertips with
+// skin's friction (frictionless, a round body rolls away under the finger: docs/haptics.md); and
+// soft tissue (the liver's) for a soft body whose material gives neither moduli nor compliances.
 constexpr int kSceneSubsteps = 8;
+constexpr FingertipFriction kSkin{0.8f, 0.6f};
 constexpr ElasticModuli kSoftTissue{3.0e4f, 0.45f, 1060.0f, 0.005f};
 
 namespace fs = std::filesystem;
@@ -656,7 +658,8 @@ HandSpec readHand(const Table& t, const std::vector<BodySpec>& bodies) {
   std::string_view model = "g1";
   t.readChoice("model", model, kModels);
   hand.rig = model == "pro" ? HandRigSettings::pro() : HandRigSettings::g1();
-  hand.rig.contact = FingertipContactMode::Triangles;  // the scene default, unlike HandRigSettings'
+  hand.rig.contact = FingertipContactMode::Triangles;  // the scene defaults, unlike HandRigSettings'
+  hand.rig.friction = kSkin;
   t.readChoice("contact", hand.rig.contact, kContacts);
   t.readNumber("fingertip_radius", hand.rig.geometry.fingertipRadius, kPositive);
   t.readNumber("compliance", hand.rig.compliance, kNonNegative);

@@ -396,6 +396,8 @@ TEST(SceneFile, AbsentKeysKeepTheirDefaults) {
   EXPECT_TRUE(s.hand.enabled);
   EXPECT_FALSE(s.hand.rig.fingers[int(Finger::Ring)]);  // g1
   EXPECT_EQ(s.hand.rig.contact, FingertipContactMode::Triangles);
+  EXPECT_EQ(s.hand.rig.friction.staticFriction, 0.8f);  // skin, unlike HandRigSettings' frictionless
+  EXPECT_EQ(s.hand.rig.friction.dynamicFriction, 0.6f);
   EXPECT_TRUE(s.hand.grasp.enabled);
   EXPECT_EQ(s.hand.grasp.mode, GraspMode::Local);
   ASSERT_EQ(s.hand.actions.size(), 1u);
