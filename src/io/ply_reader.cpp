@@ -187,13 +187,15 @@ TriMesh readPly(const std::filesystem::path& path, const std::string& bytes) {
           const double value = data.read(prop.type);
           if (!indices) continue;
           if (!(value >= 0 && value < double(mesh.vertices.size()) && value == std::floor(value)))
-            throw Error(fmt::format("{}: face {} refers to vertex {}, but there are {} vertices", name, i, value,
-                                    mesh.vertices.size()));
+            throw Error(
+                fmt::format("{}: face {} refers to vertex {}, but there are {} vertices (numbered from 0 in PLY)", name,
+                            i + 1, value, mesh.vertices.size()));
           polygon[k] = static_cast<Index>(value);
         }
         if (!indices) continue;
         if (!haveVertices) throw Error(fmt::format("{}: faces come before vertices", name));
-        if (polygon.size() < 3) throw Error(fmt::format("{}: face {} has only {} corners", name, i, polygon.size()));
+        if (polygon.size() < 3)
+          throw Error(fmt::format("{}: face {} has only {} corners", name, i + 1, polygon.size()));
         for (std::size_t k = 1; k + 1 < polygon.size(); ++k)
           mesh.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
       }

@@ -46,7 +46,7 @@ TriMesh weld(const TriMesh& raw, const std::string& name) {
     for (int k = 0; k < 3; ++k) {
       const Vec3& p = raw.vertices[raw.triangles[t][k]];
       if (!isFinite(p))
-        throw Error(fmt::format("{}: face {} has a non-finite vertex ({}, {}, {})", name, t, p.x(), p.y(), p.z()));
+        throw Error(fmt::format("{}: face {} has a non-finite vertex ({}, {}, {})", name, t + 1, p.x(), p.y(), p.z()));
       const auto [it, added] = indexOf.try_emplace(keyOf(p), static_cast<Index>(mesh.vertices.size()));
       if (added) mesh.vertices.push_back(p);
       triangle[k] = it->second;

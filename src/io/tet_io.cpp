@@ -30,19 +30,19 @@ void checkReadMesh(const TetMesh& mesh, const std::string& name) {
     throw Error(fmt::format("{}: {} vertices are more than this library can index", name, mesh.vertices.size()));
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
     if (!isFinite(mesh.vertices[v]))
-      throw Error(fmt::format("{}: vertex {} (0-based) has a non-finite or out-of-range coordinate ({}, {}, {})", name,
-                              v, mesh.vertices[v].x(), mesh.vertices[v].y(), mesh.vertices[v].z()));
+      throw Error(fmt::format("{}: vertex {} has a non-finite or out-of-range coordinate ({}, {}, {})", name, v + 1,
+                              mesh.vertices[v].x(), mesh.vertices[v].y(), mesh.vertices[v].z()));
 }
 
 void checkWritableMesh(const TetMesh& mesh) {
   if (mesh.tets.empty()) throw Error("cannot write a tet mesh without tetrahedra");
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
-    if (!isFinite(mesh.vertices[v])) throw Error(fmt::format("cannot write vertex {}: non-finite coordinate", v));
+    if (!isFinite(mesh.vertices[v])) throw Error(fmt::format("cannot write vertex {}: non-finite coordinate", v + 1));
   for (std::size_t t = 0; t < mesh.tets.size(); ++t)
     for (Index i : mesh.tets[t])
       if (i >= mesh.vertices.size())
-        throw Error(fmt::format("cannot write tet {}: it refers to vertex {}, but there are only {} vertices", t, i,
-                                mesh.vertices.size()));
+        throw Error(fmt::format("cannot write tet {}: it refers to vertex {}, but there are only {} vertices", t + 1,
+                                std::size_t(i) + 1, mesh.vertices.size()));
 }
 
 }  // namespace io

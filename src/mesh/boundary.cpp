@@ -22,8 +22,8 @@ std::vector<Triangle> boundaryFaces(const TetMesh& mesh) {
     const Tet& tet = mesh.tets[t];
     for (Index i : tet)
       if (i >= mesh.vertices.size())
-        throw Error(
-            fmt::format("tet {} refers to vertex {}, but there are only {} vertices", t, i, mesh.vertices.size()));
+        throw Error(fmt::format("tet {} refers to vertex {}, but there are only {} vertices", t + 1, std::size_t(i) + 1,
+                                mesh.vertices.size()));
     for (int f = 0; f < 4; ++f) {
       Triangle key = {tet[kFace[f][0]], tet[kFace[f][1]], tet[kFace[f][2]]};
       std::sort(key.begin(), key.end());

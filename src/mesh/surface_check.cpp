@@ -7,6 +7,7 @@
 #include <numbers>
 #include <numeric>
 
+#include "mesh/one_based.h"
 #include "mesh/triangle_intersection.h"
 #include "vrdeform/error.h"
 #include "vrdeform/mesh/bvh.h"
@@ -137,7 +138,6 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
   auto add = [&](SurfaceDefect defect, std::size_t count, std::vector<Index> ids, std::string message) {
     report.issues.push_back({defect, count, firstIds(std::move(ids), listed), std::move(message)});
   };
-  auto faceList = [&](const std::vector<Index>& ids) { return fmt::format("{}", fmt::join(ids, ", ")); };
 
   if (nf == 0) {
     add(SurfaceDefect::Empty, 0, {}, fmt::format("surface has no faces ({})", plural(nv, "vertex", "vertices")));
@@ -159,14 +159,14 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
     if (outside != t.end()) {
       state[f] = FaceState::BadIndex;
       if (badIndex.empty())
-        badIndexDetail = fmt::format("face {} refers to vertex {}, but there are only {}", f, *outside,
+        badIndexDetail = fmt::format("face {} refers to vertex {}, but there are only {}", f + 1, oneBased(*outside),
                                      plural(nv, "vertex", "vertices"));
       badIndex.push_back(Index(f));
     } else if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
       state[f] = FaceState::RepeatedIndex;
       if (degenerate.empty())
-        degenerateDetail =
-            fmt::format("face {} uses vertex {} twice ({})", f, t[1] == t[2] ? t[1] : t[0], fmt::join(t, ", "));
+        degenerateDetail = fmt::format("face {} uses vertex {} twice ({})", f + 1, oneBased(t[1] == t[2] ? t[1] : t[0]),
+                                       oneBasedList(t));
       degenerate.push_back(Index(f));
     } else if (!finite[t[0]] || !finite[t[1]] || !finite[t[2]]) {
       state[f] = FaceState::NonFinite;
@@ -178,7 +178,7 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
       if (!(twiceArea >= kDegenerateShape * longest * longest) || longest == 0) {
         state[f] = FaceState::Degenerate;
         if (degenerate.empty())
-          degenerateDetail = fmt::format("face {} has zero area (vertices {} are collinear)", f, fmt::join(t, ", "));
+          degenerateDetail = fmt::format("face {} has zero area (vertices {} are collinear)", f + 1, oneBasedList(t));
         degenerate.push_back(Index(f));
       }
     }
@@ -192,10 +192,10 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
       std::string usedBy = "unused";
       for (std::size_t f = 0; f < nf; ++f)
         if (state[f] == FaceState::NonFinite && std::count(mesh.triangles[f].begin(), mesh.triangles[f].end(), v)) {
-          usedBy = fmt::format("in face {}", f);
+          usedBy = fmt::format("in face {}", f + 1);
           break;
         }
-      details.push_back(fmt::format("vertex {} = ({}, {}, {}) {}", v, x.x(), x.y(), x.z(), usedBy));
+      details.push_back(fmt::format("vertex {} = ({}, {}, {}) {}", oneBased(v), x.x(), x.y(), x.z(), usedBy));
     }
     add(SurfaceDefect::NonFinite, nonFinite.size(), nonFinite,
         nonFinite.size() == 1 ? fmt::format("a vertex has a non-finite coordinate: {}", details[0])
@@ -206,12 +206,12 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
     add(SurfaceDefect::BadIndex, badIndex.size(), badIndex,
         badIndex.size() == 1 ? badIndexDetail
                              : fmt::format("{} faces have out-of-range vertex indices ({}; first faces {})",
-                                           badIndex.size(), badIndexDetail, faceList(firstIds(badIndex, listed))));
+                                           badIndex.size(), badIndexDetail, oneBasedList(firstIds(badIndex, listed))));
   if (!degenerate.empty())
     add(SurfaceDefect::DegenerateFace, degenerate.size(), degenerate,
         degenerate.size() == 1 ? degenerateDetail
                                : fmt::format("{} degenerate faces ({}; first faces {})", degenerate.size(),
-                                             degenerateDetail, faceList(firstIds(degenerate, listed))));
+                                             degenerateDetail, oneBasedList(firstIds(degenerate, listed))));
 
   // Edges: half-edges sorted by undirected edge, then face.
   std::vector<HalfEdge> halfEdges;
@@ -255,7 +255,8 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
       const Index f = halfEdges[i].face, g = halfEdges[i + 1].face;
       const bool flipped = halfEdges[i].from == halfEdges[i + 1].from;
       if (flipped && inconsistentEdges++ == 0)
-        inconsistentDetail = fmt::format("edge {}-{} by faces {} and {}", lo, hi, f, g);
+        inconsistentDetail =
+            fmt::format("edge {}-{} by faces {} and {}", oneBased(lo), oneBased(hi), oneBased(f), oneBased(g));
       links.push_back({f, g, flipped});
       fans.unite(corner(f, lo), corner(g, lo));
       fans.unite(corner(f, hi), corner(g, hi));
@@ -263,8 +264,8 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
       std::vector<Index> sharing;
       for (std::size_t m = i; m < j; ++m) sharing.push_back(halfEdges[m].face);
       if (nonManifoldEdges++ == 0)
-        nonManifoldDetail =
-            fmt::format("edge {}-{} is shared by {} faces: {}", lo, hi, sharing.size(), faceList(sharing));
+        nonManifoldDetail = fmt::format("edge {}-{} is shared by {} faces: {}", oneBased(lo), oneBased(hi),
+                                        sharing.size(), oneBasedList(sharing));
       nonManifoldFaces.insert(nonManifoldFaces.end(), sharing.begin(), sharing.end());
       onNonManifoldEdge[lo] = onNonManifoldEdge[hi] = 1;
     }
@@ -293,7 +294,8 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
         } else if (fanOf[v] != fan && !pinched[v]) {
           pinched[v] = 1;
           if (count++ == 0)
-            detail = fmt::format("faces {} and {} meet only at vertex {}, in separate fans", fanFace[v], f, v);
+            detail = fmt::format("faces {} and {} meet only at vertex {}, in separate fans", oneBased(fanFace[v]),
+                                 f + 1, oneBased(v));
           pinchedFaces.push_back(fanFace[v]);
           pinchedFaces.push_back(Index(f));
         }
@@ -308,7 +310,7 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
     add(SurfaceDefect::BoundaryEdge, report.boundaryEdges, boundaryFaces,
         fmt::format("surface is open: {} (first faces {})",
                     plural(report.boundaryEdges, "boundary edge", "boundary edges"),
-                    faceList(firstIds(boundaryFaces, listed))));
+                    oneBasedList(firstIds(boundaryFaces, listed))));
 
   if (inconsistentEdges > 0) {
     // Give each face a flip relative to the first face of its patch; the minority of each patch
@@ -346,9 +348,11 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
     add(SurfaceDefect::InconsistentOrientation, inconsistentEdges, toReverse,
         fmt::format("orientation is inconsistent: {} traversed in the same direction by both faces ({}); {}",
                     plural(inconsistentEdges, "edge is", "edges are"), inconsistentDetail,
-                    orientable ? fmt::format("reverse {} {}", plural(toReverse.size(), "face", "faces"),
-                                             faceList(firstIds(toReverse, listed)))
-                               : std::string("the surface is not orientable")));
+                    !orientable             ? std::string("the surface is not orientable")
+                    : toReverse.size() == 1 ? fmt::format("reverse face {}", oneBased(toReverse[0]))
+                                            : fmt::format("reverse {} faces ({}{})", toReverse.size(),
+                                                          oneBasedList(firstIds(toReverse, listed)),
+                                                          toReverse.size() > listed ? ", ..." : "")));
   }
 
   // Components, their volumes and a face of each.
@@ -401,7 +405,7 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
                             std::max(tolerance[i], tolerance[j])))
           return;
         if (pairs++ < listed) {
-          examples.push_back(fmt::format("{} and {}", faces[i], faces[j]));
+          examples.push_back(fmt::format("{} and {}", oneBased(faces[i]), oneBased(faces[j])));
           involved.push_back(faces[i]);
           involved.push_back(faces[j]);
         }
@@ -436,7 +440,8 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
               ? fmt::format("surface is inside out: enclosed volume {:.6g} is negative (reverse every face)",
                             componentVolume[0])
               : fmt::format("{} of {} components are inside out (the component of face {} encloses volume {:.6g})",
-                            inward.size(), componentFace.size(), componentFace[inward[0]], componentVolume[inward[0]]));
+                            inward.size(), componentFace.size(), oneBased(componentFace[inward[0]]),
+                            componentVolume[inward[0]]));
     }
   }
   return report;

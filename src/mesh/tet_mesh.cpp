@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "mesh/one_based.h"
 #include "vrdeform/error.h"
 
 namespace vrd {
@@ -12,19 +13,20 @@ namespace {
 void checkVertices(const std::vector<Vec3>& vertices) {
   for (std::size_t v = 0; v < vertices.size(); ++v)
     if (!isFinite(vertices[v]))
-      throw Error(fmt::format("vertex {} has a non-finite coordinate ({}, {}, {})", v, vertices[v].x(), vertices[v].y(),
-                              vertices[v].z()));
+      throw Error(fmt::format("vertex {} has a non-finite coordinate ({}, {}, {})", oneBased(v), vertices[v].x(),
+                              vertices[v].y(), vertices[v].z()));
 }
 
 template <std::size_t N>
 void checkIndices(const char* what, std::size_t element, const std::array<Index, N>& idx, std::size_t vertexCount) {
   for (std::size_t k = 0; k < N; ++k) {
     if (idx[k] >= vertexCount)
-      throw Error(
-          fmt::format("{} {} refers to vertex {}, but there are only {} vertices", what, element, idx[k], vertexCount));
+      throw Error(fmt::format("{} {} refers to vertex {}, but there are only {} vertices", what, oneBased(element),
+                              oneBased(idx[k]), vertexCount));
     for (std::size_t j = 0; j < k; ++j)
       if (idx[j] == idx[k])
-        throw Error(fmt::format("{} {} uses vertex {} twice ({})", what, element, idx[k], fmt::join(idx, ", ")));
+        throw Error(fmt::format("{} {} uses vertex {} twice ({})", what, oneBased(element), oneBased(idx[k]),
+                                oneBasedList(idx)));
   }
 }
 
@@ -44,11 +46,11 @@ void validateTetMesh(const TetMesh& mesh) {
       for (int b = a + 1; b < 4; ++b) longest = std::max(longest, (p[a] - p[b]).norm());
     const double shape = 6 * volume / (longest * longest * longest);
     if (std::abs(shape) < kDegenerateShape)
-      throw Error(fmt::format("tet {} (vertices {}) is degenerate: rest volume {:.3g} for longest edge {:.3g}", t,
-                              fmt::join(tet, ", "), volume, longest));
+      throw Error(fmt::format("tet {} (vertices {}) is degenerate: rest volume {:.3g} for longest edge {:.3g}",
+                              oneBased(t), oneBasedList(tet), volume, longest));
     if (volume < 0)
-      throw Error(fmt::format("tet {} (vertices {}) is inverted: signed rest volume {:.3g} (swap two vertices)", t,
-                              fmt::join(tet, ", "), volume));
+      throw Error(fmt::format("tet {} (vertices {}) is inverted: signed rest volume {:.3g} (swap two vertices)",
+                              oneBased(t), oneBasedList(tet), volume));
   }
 }
 
@@ -62,7 +64,7 @@ void validateTriMesh(const TriMesh& mesh) {
                         c = mesh.vertices[tri[2]].cast<double>();
     const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
     if ((b - a).cross(c - a).norm() < kDegenerateShape * longest * longest)
-      throw Error(fmt::format("triangle {} (vertices {}) is degenerate (zero area)", t, fmt::join(tri, ", ")));
+      throw Error(fmt::format("triangle {} (vertices {}) is degenerate (zero area)", oneBased(t), oneBasedList(tri)));
   }
 }
 
@@ -72,7 +74,8 @@ std::size_t removeUnusedVertices(TetMesh& mesh) {
   for (std::size_t e = 0; e < mesh.tets.size(); ++e)
     for (Index v : mesh.tets[e]) {
       if (v >= remap.size())
-        throw Error(fmt::format("tet {} refers to vertex {}, but there are only {} vertices", e, v, remap.size()));
+        throw Error(fmt::format("tet {} refers to vertex {}, but there are only {} vertices", oneBased(e), oneBased(v),
+                                remap.size()));
       remap[v] = 0;
     }
   std::vector<Vec3> kept;

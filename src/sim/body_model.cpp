@@ -197,7 +197,7 @@ std::shared_ptr<const BodyModel> makeSoftBody(const TetMesh& mesh, const Materia
     }
   }
   for (std::size_t v = 0; v < n; ++v)
-    if (!used[v]) throw Error(fmt::format("vertex {} is not used by any tet; remove unused vertices first", v));
+    if (!used[v]) throw Error(fmt::format("vertex {} is not used by any tet; remove unused vertices first", v + 1));
   model->invMass = inverseMasses(lumpedMass, material.particleMass);
 
   // Elastic mapping (docs/materials.md): strain + volume energies equal linear elasticity at small strain.
@@ -263,7 +263,7 @@ std::shared_ptr<const BodyModel> makeCloth(const TriMesh& mesh, const Material& 
   }
   for (std::size_t v = 0; v < lumpedMass.size(); ++v)
     if (!(lumpedMass[v] > 0.0))
-      throw Error(fmt::format("vertex {} is not used by any triangle; remove unused vertices first", v));
+      throw Error(fmt::format("vertex {} is not used by any triangle; remove unused vertices first", v + 1));
   model->invMass = inverseMasses(lumpedMass, material.particleMass);
   model->damping = dampingOf(material);
   model->particleRadius = material.particleRadius;

@@ -20,40 +20,41 @@ TEST(InputValidation, TetMeshErrorsNameTheElement) {
   TetMesh mesh = makeBoxTets(Vec3::Zero(), Vec3::Ones(), 2, 1, 1);
   const Material m;
 
+  // Messages number tets and vertices from 1, as a user counts them: tets[3] is tet 4.
   TetMesh inverted = mesh;
   std::swap(inverted.tets[3][1], inverted.tets[3][2]);
   std::string msg = errorOf([&] { makeSoftBody(inverted, m); });
-  EXPECT_NE(msg.find("tet 3"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("tet 4 ("), std::string::npos) << msg;
   EXPECT_NE(msg.find("inverted"), std::string::npos) << msg;
 
   TetMesh flat = unitTet();
   flat.vertices[3] = Vec3(0.3f, 0.3f, 0.0f);  // in the plane of the other three
   msg = errorOf([&] { makeSoftBody(flat, m); });
-  EXPECT_NE(msg.find("tet 0"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("tet 1 ("), std::string::npos) << msg;
   EXPECT_NE(msg.find("degenerate"), std::string::npos) << msg;
 
   TetMesh nan = mesh;
   nan.vertices[5].y() = std::numeric_limits<float>::quiet_NaN();
   msg = errorOf([&] { makeSoftBody(nan, m); });
-  EXPECT_NE(msg.find("vertex 5"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("vertex 6 "), std::string::npos) << msg;
 
   TetMesh inf = mesh;
   inf.vertices[2].x() = std::numeric_limits<float>::infinity();
-  EXPECT_NE(errorOf([&] { makeSoftBody(inf, m); }).find("vertex 2"), std::string::npos);
+  EXPECT_NE(errorOf([&] { makeSoftBody(inf, m); }).find("vertex 3 "), std::string::npos);
 
   TetMesh outOfRange = mesh;
   outOfRange.tets[7][2] = 999;
   msg = errorOf([&] { makeSoftBody(outOfRange, m); });
-  EXPECT_NE(msg.find("tet 7"), std::string::npos) << msg;
-  EXPECT_NE(msg.find("999"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("tet 8 "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("vertex 1000"), std::string::npos) << msg;
 
   TetMesh repeated = mesh;
   repeated.tets[4][3] = repeated.tets[4][0];
-  EXPECT_NE(errorOf([&] { makeSoftBody(repeated, m); }).find("tet 4"), std::string::npos);
+  EXPECT_NE(errorOf([&] { makeSoftBody(repeated, m); }).find("tet 5 "), std::string::npos);
 
   TetMesh unused = unitTet();
   unused.vertices.push_back(Vec3(5, 5, 5));
-  EXPECT_NE(errorOf([&] { makeSoftBody(unused, m); }).find("vertex 4"), std::string::npos);
+  EXPECT_NE(errorOf([&] { makeSoftBody(unused, m); }).find("vertex 5 "), std::string::npos);
 
   EXPECT_NE(errorOf([&] { makeSoftBody(TetMesh{}, m); }).find("no tetrahedra"), std::string::npos);
 }

@@ -309,10 +309,12 @@ TEST(SurfaceCheck, FinMakesANonManifoldEdge) {
   mesh.triangles.push_back({base[0], base[1], Index(mesh.vertices.size() - 1)});
   const SurfaceReport report = checkSurface(mesh);
   const SurfaceIssue& issue = issueOf(report, SurfaceDefect::NonManifoldEdge);
-  EXPECT_TRUE(contains(issue.message, "edge " + std::to_string(std::min(base[0], base[1])) + "-" +
-                                          std::to_string(std::max(base[0], base[1])) + " is shared by 3 faces: "))
+  // Messages number faces and vertices from 1, as OBJ files do.
+  EXPECT_TRUE(contains(issue.message, "edge " + std::to_string(std::min(base[0], base[1]) + 1) + "-" +
+                                          std::to_string(std::max(base[0], base[1]) + 1) + " is shared by 3 faces: "))
       << issue.message;
-  EXPECT_TRUE(contains(issue.message, "12")) << issue.message;  // the fin
+  EXPECT_TRUE(contains(issue.message, ": 1, ")) << issue.message;  // faces[0] is face 1
+  EXPECT_TRUE(contains(issue.message, "13")) << issue.message;     // the fin, faces[12]
   EXPECT_EQ(issueOf(report, SurfaceDefect::BoundaryEdge).count, 2u);
 }
 
@@ -326,7 +328,7 @@ TEST(SurfaceCheck, PinchedVertex) {
   ASSERT_EQ(report.issues.size(), 1u) << report.summary();
   const SurfaceIssue& issue = issueOf(report, SurfaceDefect::NonManifoldVertex);
   EXPECT_EQ(issue.count, 1u);
-  EXPECT_TRUE(contains(issue.message, "meet only at vertex 0")) << issue.message;
+  EXPECT_TRUE(contains(issue.message, "meet only at vertex 1,")) << issue.message;
 }
 
 TEST(SurfaceCheck, OneFlippedFace) {
@@ -338,7 +340,7 @@ TEST(SurfaceCheck, OneFlippedFace) {
   EXPECT_EQ(issue.count, 3u);
   EXPECT_EQ(issue.firstFaces, ids({5}));
   EXPECT_TRUE(contains(issue.message, "3 edges are traversed in the same direction")) << issue.message;
-  EXPECT_TRUE(contains(issue.message, "reverse 1 face 5")) << issue.message;
+  EXPECT_TRUE(contains(issue.message, "reverse face 6")) << issue.message;
   EXPECT_THROW(requireClosedSurface(mesh), Error);
 }
 
@@ -403,13 +405,13 @@ TEST(SurfaceCheck, NonFiniteCoordinate) {
   const SurfaceIssue& issue = issueOf(report, SurfaceDefect::NonFinite);
   EXPECT_EQ(issue.count, 1u);
   EXPECT_EQ(issue.firstFaces, ids({3}));  // the vertex
-  EXPECT_TRUE(contains(issue.message, "vertex 3 = (nan, ")) << issue.message;
+  EXPECT_TRUE(contains(issue.message, "vertex 4 = (nan, ")) << issue.message;
   Index user = 0;
   while (std::count(mesh.triangles[user].begin(), mesh.triangles[user].end(), 3) == 0) ++user;
-  EXPECT_TRUE(contains(issue.message, "in face " + std::to_string(user))) << issue.message;
+  EXPECT_TRUE(contains(issue.message, "in face " + std::to_string(user + 1))) << issue.message;
   EXPECT_TRUE(std::isfinite(report.area));
   EXPECT_TRUE(std::isfinite(report.volume));
-  EXPECT_TRUE(contains(errorOf([&] { requireClosedSurface(mesh); }), "vertex 3"));
+  EXPECT_TRUE(contains(errorOf([&] { requireClosedSurface(mesh); }), "vertex 4 "));
 
   mesh.vertices[5].z() = std::numeric_limits<float>::infinity();
   EXPECT_EQ(issueOf(checkSurface(mesh), SurfaceDefect::NonFinite).firstFaces, ids({3, 5}));
@@ -421,7 +423,7 @@ TEST(SurfaceCheck, DegenerateFaces) {
   const SurfaceReport report = checkSurface(repeated);
   const SurfaceIssue& issue = issueOf(report, SurfaceDefect::DegenerateFace);
   EXPECT_EQ(issue.firstFaces, ids({4}));
-  EXPECT_TRUE(contains(issue.message, "face 4 uses vertex " + std::to_string(repeated.triangles[4][0]) + " twice"))
+  EXPECT_TRUE(contains(issue.message, "face 5 uses vertex " + std::to_string(repeated.triangles[4][0] + 1) + " twice"))
       << issue.message;
   EXPECT_THROW(requireClosedSurface(repeated), Error);
 
@@ -433,7 +435,7 @@ TEST(SurfaceCheck, DegenerateFaces) {
   const SurfaceReport flat = checkSurface(collinear, open);
   ASSERT_EQ(flat.issues.size(), 1u) << flat.summary();
   EXPECT_EQ(issueOf(flat, SurfaceDefect::DegenerateFace).firstFaces, ids({1}));
-  EXPECT_TRUE(contains(flat.issues[0].message, "face 1 has zero area")) << flat.issues[0].message;
+  EXPECT_TRUE(contains(flat.issues[0].message, "face 2 has zero area")) << flat.issues[0].message;
 }
 
 TEST(SurfaceCheck, OutOfRangeIndex) {
@@ -442,9 +444,9 @@ TEST(SurfaceCheck, OutOfRangeIndex) {
   const SurfaceReport report = checkSurface(mesh);
   const SurfaceIssue& issue = issueOf(report, SurfaceDefect::BadIndex);
   EXPECT_EQ(issue.firstFaces, ids({7}));
-  EXPECT_EQ(issue.message, "face 7 refers to vertex 99, but there are only 8 vertices");
+  EXPECT_EQ(issue.message, "face 8 refers to vertex 100, but there are only 8 vertices");
   EXPECT_TRUE(std::isfinite(enclosedVolume(mesh)));  // the face is skipped
-  EXPECT_TRUE(contains(errorOf([&] { requireClosedSurface(mesh); }), "face 7 refers to vertex 99"));
+  EXPECT_TRUE(contains(errorOf([&] { requireClosedSurface(mesh); }), "face 8 refers to vertex 100"));
 }
 
 TEST(SurfaceCheck, EmptyMesh) {

@@ -652,10 +652,10 @@ TEST(TetIo, WritingIntoAMissingFolderFailsAndLeavesNothing) {
 
   TetMesh bad = mesh;
   bad.tets[2][1] = 99;
-  EXPECT_ERROR_MENTIONS(writeTetMesh(dir / "bad.vtu", bad), "tet 2");
+  EXPECT_ERROR_MENTIONS(writeTetMesh(dir / "bad.vtu", bad), "tet 3: it refers to vertex 100");
   bad = mesh;
   bad.vertices[3].x() = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_ERROR_MENTIONS(writeTetMesh(dir / "bad.mesh", bad), "vertex 3");
+  EXPECT_ERROR_MENTIONS(writeTetMesh(dir / "bad.mesh", bad), "vertex 4:");
   EXPECT_ERROR_MENTIONS(writeTetMesh(dir / "bad.stl", mesh), "unknown tet mesh format");
   EXPECT_TRUE(dir.files().empty());
 }
@@ -785,7 +785,7 @@ TEST(Boundary, BoxBoundaryIsClosedDeterministicAndSkipsSharedFaces) {
   }
   TetMesh bad = kTwoTets;
   bad.tets[1][3] = 5;
-  EXPECT_ERROR_MENTIONS(boundaryFaces(bad), "tet 1 refers to vertex 5");
+  EXPECT_ERROR_MENTIONS(boundaryFaces(bad), "tet 2 refers to vertex 6");
 }
 
 TEST(Boundary, SurfaceKeepsOnlyBoundaryVerticesAndMapsThemBack) {
