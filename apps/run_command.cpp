@@ -125,16 +125,22 @@ void printSummary(const RunSummary& r, const BuiltScene& scene) {
   fmt::print("\nper-stage latency (paper Table 3), ms per step:\n{}", latencyTable(r.latency));
 }
 
+// The run's timeline: every finger of the hand, normalised and in newtons, each report interval
+// (a bar on a terminal instead).
 class Progress {
  public:
-  Progress(double seconds, double reportEvery, double dt, bool hand)
+  Progress(double seconds, double reportEvery, double dt, const HandSpec& hand)
       : seconds_(seconds),
         tty_(::isatty(STDOUT_FILENO) == 1),
         every_(std::max<std::uint64_t>(1, std::llround(reportEvery / dt))),
-        hand_(hand) {
-    if (!tty_)
-      fmt::print("{:>8} {:>8} {:>10} {:>8} {:>8} {:>6} {:>10}\n", "t (s)", "index", "index (N)", "hand", "contacts",
-                 "grasp", "vol. loss");
+        hand_(hand.enabled) {
+    for (int f = 0; f < kFingerCount; ++f)
+      if (hand.rig.fingers[std::size_t(f)]) fingers_.push_back(Finger(f));
+    if (tty_) return;
+    std::string header = fmt::format("{:>8}", "t (s)");
+    for (const Finger f : fingers_)
+      header += fmt::format(" {:>8} {:>10}", fingerName(f), fmt::format("{} (N)", fingerName(f)));
+    fmt::print("{} {:>8} {:>8} {:>6} {:>10}\n", header, "hand", "contacts", "grasp", "vol. loss");
   }
   void step(const RunStep& s) {
     if (tty_) {
@@ -148,17 +154,21 @@ class Progress {
       return;
     }
     if ((s.step + 1) % every_ != 0) return;
+    std::string line = fmt::format("{:8.3f}", s.time);
     if (!hand_ || !s.session) {
-      fmt::print("{:8.3f} {:>8} {:>10} {:>8} {:>8} {:>6} {:9.3f}%\n", s.time, "-", "-", "-", "-", "-",
-                 100 * s.volumeLoss);
+      for (std::size_t k = 0; k < fingers_.size(); ++k) line += fmt::format(" {:>8} {:>10}", "-", "-");
+      fmt::print("{} {:>8} {:>8} {:>6} {:9.3f}%\n", line, "-", "-", "-", 100 * s.volumeLoss);
       return;
     }
     const HapticFrame& h = s.session->haptics();
     std::size_t contacts = 0;
     for (const FingerHaptics& f : h.fingers) contacts += f.contacts;
-    const FingerHaptics& index = h.fingers[int(Finger::Index)];
-    fmt::print("{:8.3f} {:8.3f} {:10.4f} {:8.3f} {:8} {:>6} {:9.3f}%\n", s.time, index.force, index.newtons, h.paper,
-               contacts, s.session->grasp().active() ? "on" : "off", 100 * s.volumeLoss);
+    for (const Finger f : fingers_) {
+      const FingerHaptics& finger = h.fingers[int(f)];
+      line += fmt::format(" {:8.3f} {:10.4f}", finger.force, finger.newtons);
+    }
+    fmt::print("{} {:8.3f} {:8} {:>6} {:9.3f}%\n", line, h.paper, contacts, s.session->grasp().active() ? "on" : "off",
+               100 * s.volumeLoss);
   }
   void finish() {
     if (tty_) fmt::print("\n");
@@ -169,6 +179,7 @@ class Progress {
   bool tty_;
   std::uint64_t every_;
   bool hand_;
+  std::vector<Finger> fingers_;
 };
 
 // What a recording of `vrdeform run` keeps to run again: the scene as named and the solver's overrides.
@@ -262,7 +273,7 @@ int run(RunArgs a) {
       return 1;
     }
   }
-  Progress progress(seconds, a.reportEvery, dt, spec.hand.enabled);
+  Progress progress(seconds, a.reportEvery, dt, spec.hand);
   settings.afterStep = [&](const RunStep& s) {
     progress.step(s);
     if (video) video->afterStep(s);
