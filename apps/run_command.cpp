@@ -40,7 +40,9 @@ std::string fingerList(const std::array<bool, kFingerCount>& fingers) {
   return s;
 }
 
-void printScene(const BuiltScene& scene) {
+// `handFrom`: what moves the hand instead of the scene's scripted actions (a glove, a recording),
+// or empty.
+void printScene(const BuiltScene& scene, std::string_view handFrom) {
   const SceneSpec& s = scene.spec;
   for (const SceneBody& b : scene.bodies) {
     double mass = 0.0;
@@ -65,6 +67,10 @@ void printScene(const BuiltScene& scene) {
              !s.hand.grasp.enabled                   ? "off"
              : s.hand.grasp.mode == GraspMode::Paper ? "paper"
                                                      : "local");
+  if (!handFrom.empty()) {
+    fmt::print("  moved by {}: the scene's scripted actions do not run\n", handFrom);
+    return;
+  }
   for (const HandAction& a : scene.actions)
     fmt::print("  {} with the {} at {:.1f}-{:.1f} s on ({:.3f}, {:.3f}, {:.3f}) m\n",
                a.kind == ActionKind::Poke ? "poke" : "grasp", fingerName(a.finger), a.start, a.end(), a.target.x(),
@@ -212,7 +218,9 @@ int run(RunArgs a) {
   fmt::print("scene {}: {}\n  from {}\n", spec.name, spec.description, spec.source);
   const StopSignals signals;  // from here on Ctrl-C stops what runs: meshing, settling, calibrating, the run
   BuiltScene scene = buildScene(spec, commandObserver(signals));
-  printScene(scene);
+  printScene(scene, !a.weart.empty() ? fmt::format("the WEART glove at {}", a.weart)
+                    : replaying      ? fmt::format("the recording {}", a.replay)
+                                     : std::string());
 
   const double dt = spec.solver.timeStep;
   std::optional<GloveLink> glove;
