@@ -98,6 +98,15 @@ void printSummary(const RunSummary& r, const BuiltScene& scene) {
             "steps, peak {:.3f}{}\n",
             p.start, fingerName(p.finger), channel, q->roughness, q->loadingSpearman, 100 * q->holdNoise, q->lagSteps,
             q->peak, unit);
+    for (const GraspOutcome& g : r.grasps)
+      if (g.heldSeconds > 0.0)
+        fmt::print("  grasp at {:.2f} s (thumb and {}): held {:.2f} s of its {:.2f}\n", g.start, fingerName(g.finger),
+                   g.heldSeconds, g.seconds);
+      else
+        fmt::print(
+            "  grasp at {:.2f} s (thumb and {}): never took hold (the two fingertips never pushed the body at once "
+            "while closing: aim it where both reach the body, or give it more `depth`)\n",
+            g.start, fingerName(g.finger));
   }
   fmt::print(
       "  convergence (the last iteration's corrections / mean rest edge; RMS mean, max), {:.1f} iterations "

@@ -235,6 +235,10 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
   std::stable_sort(pokes.begin(), pokes.end(),
                    [](const PokeTrace& a, const PokeTrace& b) { return a.poke->start < b.poke->start; });
   std::size_t firstOpen = 0;
+  // The scripted grasps, each with the steps it held the body while its time ran.
+  std::vector<std::pair<const HandAction*, std::uint64_t>> grasps;
+  for (const HandAction& a : scene.actions)
+    if (a.kind == ActionKind::Grasp) grasps.push_back({&a, 0});
   constexpr std::size_t kEventsListed = 100;  // in summary.events; nanEvents counts them all
   for (const SimEvent& e : scene.settleEvents)
     if (++summary.nanEvents <= kEventsListed)
@@ -303,6 +307,8 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
             }
           }
         while (firstOpen < pokes.size() && pokes[firstOpen].done) ++firstOpen;
+        if (input == scene.input.get() && session->grasp().active())
+          for (auto& [grasp, held] : grasps) held += began >= grasp->start && began < grasp->end();
         traces.add(t, h, session->rig(), poking);
       }
       if (files) files->step(scene, session ? &*session : nullptr, times, k, t, contact);
@@ -315,6 +321,10 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
     summary.error = e.what();
   }
   for (HapticOutput* out : settings.outputs) out->release();
+  if (input == scene.input.get())
+    for (const auto& [grasp, held] : grasps)
+      if (grasp->end() <= double(summary.steps) * summary.dt + 1e-9)
+        summary.grasps.push_back({grasp->finger, grasp->start, grasp->end() - grasp->start, double(held) * summary.dt});
   for (std::size_t s = 0; s < kStageCount; ++s)
     if (residualSteps[s] > 0) summary.residuals[s].rms = residualRmsSum[s] / double(residualSteps[s]);
   if (summary.steps > 0) {
@@ -378,6 +388,13 @@ std::string summaryJson(const RunSummary& s) {
                      {"newtons", quality(p.newtons)},
                      {"force", quality(p.force)}});
   j["pokes"] = pokes;
+  json grasps = json::array();
+  for (const GraspOutcome& g : s.grasps)
+    grasps.push_back({{"finger", std::string(fingerName(g.finger))},
+                      {"start", g.start},
+                      {"seconds", g.seconds},
+                      {"held_seconds", g.heldSeconds}});
+  j["grasps"] = grasps;
   json residuals = json::object();
   for (std::size_t k = 0; k < kStageCount; ++k)
     if (std::isfinite(s.residuals[k].max))

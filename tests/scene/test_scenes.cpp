@@ -86,6 +86,8 @@ TEST_P(EveryBody, WholeRunGraspsAndKeepsItsVolume) {
   EXPECT_EQ(r.nanEvents, 0u);
   EXPECT_LT(r.volumeLossMax, 0.01);
   EXPECT_GT(grasped, 30u) << "the pinch should hold the body for at least half a second";
+  ASSERT_EQ(r.grasps.size(), 1u);  // the summary's account of the pinch: the steps the grasp held
+  EXPECT_NEAR(r.grasps[0].heldSeconds, double(grasped) * r.dt, 1e-9);
   EXPECT_LT(r.coldSubstepShare, 0.02) << "the warm start keeps falling back: the scene needs more substeps";
   testing::record("cold_substep_share", r.coldSubstepShare);
   EXPECT_GT(r.forceMax[int(Finger::Thumb)], 0.1f);

@@ -50,6 +50,14 @@ struct PokeSignal {
   SignalQuality force;    ///< of its normalised force (what the glove gets)
 };
 
+/// One of the scene's scripted grasps whose time ran out during the run: how long it held the body.
+struct GraspOutcome {
+  Finger finger = Finger::Index;  ///< the finger that pinches with the thumb
+  double start = 0.0;             ///< s after settling
+  double seconds = 0.0;           ///< the action's length
+  double heldSeconds = 0.0;       ///< 0: it never took hold
+};
+
 struct RunSummary {
   std::string scene;
   std::uint64_t steps = 0;
@@ -61,7 +69,8 @@ struct RunSummary {
   std::array<bool, kFingerCount> fingers{};  ///< the hand's fingers
   std::array<float, kFingerCount> forceMax{}, newtonsMax{};
   float paperMax = 0.0f;
-  std::vector<PokeSignal> pokes;  ///< the scripted pokes that ran to their end
+  std::vector<PokeSignal> pokes;     ///< the scripted pokes that ran to their end
+  std::vector<GraspOutcome> grasps;  ///< the scripted grasps that ran to their end
   /// How converged the steps were, per constraint stage (StepReport::residuals): the mean of the
   /// steps' RMS and the largest max; NaN for stages not measured.
   std::array<Residual, kStageCount> residuals;
