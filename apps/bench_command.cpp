@@ -13,6 +13,8 @@
 #include <string>
 #include <thread>
 
+#include "build_observer.h"
+#include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/metrics/latency_stats.h"
@@ -28,10 +30,26 @@ using nlohmann::json;
 struct BenchArgs {
   bool json = false;
   int frames = 300;
-  bool quick = false;                // skips the 100k-tet scaling row
-  bool smoke = false;                // every table at its smallest: checks the command, measures nothing
-  SimdLevel simd = SimdLevel::Best;  // the lanes of every SIMD figure
+  bool quick = false;                    // skips the 100k-tet scaling row
+  bool smoke = false;                    // every table at its smallest: checks the command, measures nothing
+  SimdLevel simd = SimdLevel::Best;      // the lanes of every SIMD figure
+  const StopSignals* signals = nullptr;  // Ctrl-C: each part's loops end early and bench stops after it
 };
+
+bool stopped(const BenchArgs& a) { return a.signals && a.signals->requested(); }
+
+// A scene built silently, its settling stopped by Ctrl-C.
+BuiltScene benchBuild(const SceneSpec& spec, const BenchArgs& a) {
+  return a.signals ? buildScene(spec, commandObserver(*a.signals, false)) : buildScene(spec);
+}
+
+// A run that Ctrl-C ends after the current step.
+RunSettings benchRun(const BenchArgs& a, std::uint64_t steps) {
+  RunSettings run;
+  run.steps = steps;
+  run.afterStep = [&a](const RunStep&) { return !stopped(a); };
+  return run;
+}
 
 // The paper's figures (Tables 1-3), ms per frame, Unity/C# on an i7-13700K.
 struct PaperRow {
@@ -55,13 +73,11 @@ SceneSpec benchScene(const std::string& name, const BenchArgs& a) {
 }
 
 // Runs `spec` settled, without the hand, for `frames` steps; returns the per-stage statistics.
-RunSummary idleRun(SceneSpec spec, int frames) {
+RunSummary idleRun(SceneSpec spec, int frames, const BenchArgs& a) {
   spec.hand.enabled = false;
   spec.haptics.calibrate = false;
-  BuiltScene scene = buildScene(spec);
-  RunSettings run;
-  run.steps = std::uint64_t(frames);
-  return runScene(scene, run);
+  BuiltScene scene = benchBuild(spec, a);
+  return runScene(scene, benchRun(a, std::uint64_t(frames)));
 }
 
 double mean(const RunSummary& r, Stage s) { return r.latency.stage(s, Phase::All).mean; }
@@ -83,11 +99,11 @@ json table1(const BenchArgs& a, std::string& text) {
     spec.solver.substeps = 1;  // the paper's setting
     spec.solver.iterations = 5;
     spec.solver.fuseStrainVolume = false;  // and its order, so that T_v and T_s are timed apart
-    const RunSummary paperSet = idleRun(spec, a.frames);
+    const RunSummary paperSet = idleRun(spec, a.frames, a);
     spec.solver.fuseStrainVolume = true;
-    const RunSummary fusedSet = idleRun(spec, a.frames);
+    const RunSummary fusedSet = idleRun(spec, a.frames, a);
     spec.solver.substeps = sceneSubsteps;
-    const RunSummary sceneSet = idleRun(spec, a.frames);
+    const RunSummary sceneSet = idleRun(spec, a.frames, a);
     const double tv = mean(paperSet, Stage::Volume), ts = mean(paperSet, Stage::Strain),
                  tm = mean(paperSet, Stage::ShapeMatching), total = tv + ts + tm, fused = tetTotal(fusedSet),
                  sceneTotal = tetTotal(sceneSet);
@@ -120,7 +136,7 @@ json table2(const BenchArgs& a, std::string& text) {
   SceneSpec spec = benchScene("flag", a);
   spec.solver.substeps = 1;  // the paper's settings
   spec.solver.iterations = 2;
-  const RunSummary r = idleRun(spec, a.frames);
+  const RunSummary r = idleRun(spec, a.frames, a);
   const double tc = mean(r, Stage::Distance), tb = mean(r, Stage::Bend);
   text += "Table 2: the flag (cloth), ms per frame (1/60 s), stretch + bending, 1 substep x 2 iterations\n";
   text += fmt::format("{:<9} {:>7} {:>7} | {:>7} {:>7} {:>8} | {:>8} {:>8}\n", "scene", "N_c", "N_b", "T_c", "T_b",
@@ -139,11 +155,10 @@ json table2(const BenchArgs& a, std::string& text) {
 }
 
 json table3(const BenchArgs& a, std::string& text) {
-  BuiltScene scene = buildScene(benchScene("liver", a));
-  RunSettings run;
-  run.steps =
-      a.smoke ? std::uint64_t(a.frames) : std::uint64_t(std::llround(scene.spec.seconds / scene.spec.solver.timeStep));
-  const RunSummary r = runScene(scene, run);
+  BuiltScene scene = benchBuild(benchScene("liver", a), a);
+  const RunSummary r = runScene(
+      scene, benchRun(a, a.smoke ? std::uint64_t(a.frames)
+                                 : std::uint64_t(std::llround(scene.spec.seconds / scene.spec.solver.timeStep))));
   const SampleStats idle = r.latency.total(Phase::Idle), contact = r.latency.total(Phase::Contact);
   text += fmt::format("Table 3: per-stage latency of the liver scene with its poke and grasp, ms ({} frames)\n{}",
                       r.steps, latencyTable(r.latency));
@@ -171,7 +186,7 @@ json convergence(const BenchArgs& a, std::string& text) {
     SceneSpec spec = benchScene("liver", a);
     spec.solver.iterations = iterations;
     spec.solver.measureResiduals = true;
-    const RunSummary r = idleRun(spec, a.frames);
+    const RunSummary r = idleRun(spec, a.frames, a);
     const auto max = [&](Stage s) { return r.residuals[std::size_t(s)].max; };
     text += fmt::format("{:>10} | {:14.2e} {:14.2e} {:14.2e}\n", iterations, max(Stage::StrainVolume),
                         max(Stage::ShapeMatching), max(Stage::Contact));
@@ -213,11 +228,9 @@ json signalQualityTable(const BenchArgs& a, std::string& text) {
       double end = 0.0;
       for (const ActionSpec& action : spec.hand.actions)
         if (action.action.kind == ActionKind::Poke) end = action.action.end() + 0.3;
-      BuiltScene scene = buildScene(spec);  // calibrated as now
+      BuiltScene scene = benchBuild(spec, a);  // calibrated as now
       if (previous) scene.session.hand.friction = {};
-      RunSettings run;
-      run.steps = std::uint64_t(std::ceil(end / spec.solver.timeStep));
-      const RunSummary r = runScene(scene, run);
+      const RunSummary r = runScene(scene, benchRun(a, std::uint64_t(std::ceil(end / spec.solver.timeStep))));
       if (r.pokes.empty()) continue;
       const SignalQuality &n = r.pokes[0].newtons, &f = r.pokes[0].force;
       text +=
@@ -255,12 +268,12 @@ json loop(const BenchArgs& a, std::string& text) {
   for (int substeps : {spec.solver.substeps, 1}) {
     if (a.smoke && substeps != spec.solver.substeps) continue;
     spec.solver.substeps = substeps;
-    BuiltScene scene = buildScene(spec);
+    BuiltScene scene = benchBuild(spec, a);
     SimulationLoop loop(scene, {});
     const std::shared_ptr<SnapshotChannel> view = loop.subscribe();
     loop.start();
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (std::chrono::steady_clock::now() < end) {
+    while (std::chrono::steady_clock::now() < end && !stopped(a)) {
       view->update();
       std::this_thread::sleep_for(std::chrono::microseconds(11111));
     }
@@ -304,10 +317,10 @@ Material softMaterial() {
 }
 
 // Wall time of world.step(), mean over `frames` after a few warm-up steps (ms).
-double msPerStep(World& world, int frames) {
+double msPerStep(World& world, int frames, const BenchArgs& a) {
   for (int k = 0; k < 5; ++k) world.step();
   const auto start = std::chrono::steady_clock::now();
-  for (int k = 0; k < frames; ++k) world.step();
+  for (int k = 0; k < frames && !stopped(a); ++k) world.step();
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / frames;
 }
 
@@ -333,7 +346,7 @@ json scaling(const BenchArgs& a, std::string& text) {
         s.timeStages = false;
         Block b = block(mesh, softMaterial(), ConstraintSet::paper(), s);
         n = b.tets;
-        ms[simd][threads - 1] = msPerStep(*b.world, std::max(10, a.frames * 1000 / tets));
+        ms[simd][threads - 1] = msPerStep(*b.world, std::max(10, a.frames * 1000 / tets), a);
       }
     text += fmt::format("{:>8} | {:10.3f} {:10.3f} | {:10.3f} {:10.3f} | {:7.2f}x {:7.2f}x\n", n, ms[0][0], ms[0][1],
                         ms[1][0], ms[1][1], ms[0][0] / ms[1][0], ms[1][0] / ms[1][1]);
@@ -350,7 +363,7 @@ json scaling(const BenchArgs& a, std::string& text) {
 
 // A full haptic step on a 10k-tet block: predict, contacts with the ground and a fingertip pressing
 // into the top, solve, haptic force. Per-step wall times (ms) over `frames` steps of the poke.
-std::vector<double> pokedBlockSteps(SolverSettings s, int frames) {
+std::vector<double> pokedBlockSteps(SolverSettings s, int frames, const BenchArgs& a) {
   s.linearDamping = 1.0f;
   Block b = block(makeBoxTets(Vec3(-0.1f, 0.0f, -0.1f), Vec3::Constant(0.2f), 12, 12, 12), softMaterial(),
                   ConstraintSet::paper(), s);
@@ -366,7 +379,7 @@ std::vector<double> pokedBlockSteps(SolverSettings s, int frames) {
   };
   HapticSession session(*b.world, {}, frame(-0.005f));
   std::vector<double> ms;
-  for (int k = 0; k < frames; ++k) {
+  for (int k = 0; k < frames && (k == 0 || !stopped(a)); ++k) {                                // one sample at least
     const float depth = -0.005f + 0.02f * float(std::min(k, frames / 2)) / float(frames / 2);  // down 2 cm, hold
     const auto start = std::chrono::steady_clock::now();
     session.step(frame(depth));
@@ -441,7 +454,7 @@ json contention(const BenchArgs& a, std::string& text) {
           Block b = cube(s);
           for (int k = 0; k < 64; ++k) b.world->step();  // as the poked block's settling: the choice is made
           std::vector<double> steps;
-          for (int k = 0; k < frames / 3; ++k) {
+          for (int k = 0; k < frames / 3 && (k == 0 || !stopped(a)); ++k) {
             const auto start = std::chrono::steady_clock::now();
             b.world->step();
             steps.push_back(
@@ -449,7 +462,7 @@ json contention(const BenchArgs& a, std::string& text) {
           }
           ms[mode] = meanAndP90(std::move(steps));
         } else {
-          ms[mode] = meanAndP90(pokedBlockSteps(s, frames));
+          ms[mode] = meanAndP90(pokedBlockSteps(s, frames, a));
         }
       }
       const std::string name =
@@ -504,10 +517,10 @@ json targets(const BenchArgs& a, const json& table1Rows, std::string& text) {
   SolverSettings s;
   s.simd = a.simd;
   s.threads = 1;
-  const SampleStats one = summarise(pokedBlockSteps(s, frames));
+  const SampleStats one = summarise(pokedBlockSteps(s, frames, a));
   s.threads = 2;
   s.threadsFallBack = false;  // the team's figure
-  const SampleStats two = summarise(pokedBlockSteps(s, frames));
+  const SampleStats two = summarise(pokedBlockSteps(s, frames, a));
   text += fmt::format(
       "  10,368 tets pressed by a fingertip, full step (predict, contacts, solve, force): P99 {:.3f} ms on 2 threads "
       "(mean {:.3f}), {:.3f} ms on 1 (mean {:.3f}); target P99 1.0 ms\n",
@@ -528,7 +541,7 @@ json targets(const BenchArgs& a, const json& table1Rows, std::string& text) {
       s.threadsFallBack = false;
       s.timeStages = false;
       Block b = cube(s);
-      const double ms = msPerStep(*b.world, 115);  // 5 + 115 steps: 2 s
+      const double ms = msPerStep(*b.world, 115, a);  // 5 + 115 steps: 2 s
       const auto [sag, strain] = sagAndStrain(*b.world, b.body, 1.0f);
       const double perTet = double(b.world->bodyBytes(b.body)) / double(b.tets);
       text += fmt::format(
@@ -568,44 +581,55 @@ struct Machine {
   }
 };
 
-int bench(const BenchArgs& a) {
+int bench(BenchArgs a) {
   std::string text;
   json j;
   if (!cpuSupports(a.simd)) throw Error(fmt::format("bench: this CPU has no {} lanes", simdName(a.simd)));
+  const StopSignals signals;
+  a.signals = &signals;
   const Machine m(a.simd);
   j["machine"] = {{"cpu", m.cpu}, {"hardware_threads", m.threads}, {"lanes", m.lanes}};
   j["frames"] = a.frames;
-  // Progress on stderr, so that it neither mixes with --json nor stays on a page of results.
-  int part = 0;
-  const auto progress = [&](std::string_view what) {
-    fmt::print(stderr, "bench [{}/9] {}...\n", ++part, what);
-    std::fflush(stderr);
+  const auto print = [&] {
+    if (a.json)
+      fmt::print("{}\n", j.dump(2));
+    else
+      fmt::print(
+          "{}The paper: Unity/C# on an i7-13700K. Here: {} ({} hardware threads, {} lanes), one thread unless a row "
+          "says otherwise.\n",
+          text, m.cpu, m.threads, m.lanes);
   };
-  progress("Table 1: the paper's scenes");
-  j["table1"] = table1(a, text);
-  progress("Table 2: the flag");
-  j["table2"] = table2(a, text);
-  progress("Table 3: the liver's stages");
-  j["table3"] = table3(a, text);
-  progress("the real-time loop");
-  j["loop"] = loop(a, text);
-  progress("scaling");
-  j["scaling"] = scaling(a, text);
-  progress("targets");
-  j["targets"] = targets(a, j["table1"], text);
-  progress("contention");
-  j["contention"] = contention(a, text);
-  progress("signal quality");
-  j["signal"] = signalQualityTable(a, text);
-  progress("convergence");
-  j["convergence"] = convergence(a, text);
-  if (a.json)
-    fmt::print("{}\n", j.dump(2));
-  else
-    fmt::print(
-        "{}The paper: Unity/C# on an i7-13700K. Here: {} ({} hardware threads, {} lanes), one thread unless a row says "
-        "otherwise.\n",
-        text, m.cpu, m.threads, m.lanes);
+  // Each part with its progress on stderr, so that it neither mixes with --json nor stays on a page
+  // of results. Ctrl-C ends the part that runs early; what it measured is dropped, and the parts
+  // done before it are printed.
+  constexpr int kParts = 9;
+  int part = 0;
+  const auto run = [&](const char* key, std::string_view what, auto&& measure) {
+    fmt::print(stderr, "bench [{}/{}] {}...\n", ++part, kParts, what);
+    std::fflush(stderr);
+    const std::string before = text;
+    json result;
+    try {
+      result = measure();
+    } catch (const Stopped&) {  // while a scene settled
+    }
+    if (stopped(a)) {
+      text = before;
+      print();
+      throw Stopped(fmt::format("bench: stopped during {} ({} of {} parts done)", what, part - 1, kParts));
+    }
+    j[key] = std::move(result);
+  };
+  run("table1", "Table 1: the paper's scenes", [&] { return table1(a, text); });
+  run("table2", "Table 2: the flag", [&] { return table2(a, text); });
+  run("table3", "Table 3: the liver's stages", [&] { return table3(a, text); });
+  run("loop", "the real-time loop", [&] { return loop(a, text); });
+  run("scaling", "scaling", [&] { return scaling(a, text); });
+  run("targets", "targets", [&] { return targets(a, j["table1"], text); });
+  run("contention", "contention", [&] { return contention(a, text); });
+  run("signal", "signal quality", [&] { return signalQualityTable(a, text); });
+  run("convergence", "convergence", [&] { return convergence(a, text); });
+  print();
   return 0;
 }
 
