@@ -33,14 +33,14 @@ struct BenchArgs {
   bool quick = false;                    // skips the 100k-tet scaling row
   bool smoke = false;                    // every table at its smallest: checks the command, measures nothing
   SimdLevel simd = SimdLevel::Best;      // the lanes of every SIMD figure
-  const StopSignals* signals = nullptr;  // Ctrl-C: each part's loops end early and bench stops after it
+  const StopSignals* signals = nullptr;  // bench's, for Ctrl-C: each part's loops end early
 };
 
-bool stopped(const BenchArgs& a) { return a.signals && a.signals->requested(); }
+bool stopped(const BenchArgs& a) { return a.signals->requested(); }
 
 // A scene built silently, its settling stopped by Ctrl-C.
 BuiltScene benchBuild(const SceneSpec& spec, const BenchArgs& a) {
-  return a.signals ? buildScene(spec, commandObserver(*a.signals, false)) : buildScene(spec);
+  return buildScene(spec, commandObserver(*a.signals, false));
 }
 
 // A run that Ctrl-C ends after the current step.
@@ -379,7 +379,8 @@ std::vector<double> pokedBlockSteps(SolverSettings s, int frames, const BenchArg
   };
   HapticSession session(*b.world, {}, frame(-0.005f));
   std::vector<double> ms;
-  for (int k = 0; k < frames && (k == 0 || !stopped(a)); ++k) {                                // one sample at least
+  // At least one sample, stopped or not.
+  for (int k = 0; k < frames && (k == 0 || !stopped(a)); ++k) {
     const float depth = -0.005f + 0.02f * float(std::min(k, frames / 2)) / float(frames / 2);  // down 2 cm, hold
     const auto start = std::chrono::steady_clock::now();
     session.step(frame(depth));

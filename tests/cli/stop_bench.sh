@@ -5,6 +5,8 @@
 set -u
 vrdeform=$1 dir=$2
 mkdir -p "$dir"
+rm -f "$dir/out.txt" "$dir/err.txt"  # a last run's would match before this one writes
+touch "$dir/err.txt"
 "$vrdeform" bench --frames 10 > "$dir/out.txt" 2> "$dir/err.txt" &
 pid=$!
 tries=0
