@@ -310,7 +310,10 @@ TEST(VrServer, HostileInputIsRejectedAndTheLoopKeepsStepping) {
   // Oversized: the connection is closed with "message too big".
   Client b(port);
   b.next(), b.next();
-  b.send(std::string(100 * 1024, ' '));
+  try {
+    b.send(std::string(100 * 1024, ' '));
+  } catch (const beast::system_error&) {  // closed under us before the whole message went out (a broken pipe)
+  }
   const int tooBig = b.closeCode();  // the close frame, or a reset when the server closes with unread data
   EXPECT_TRUE(tooBig == int(websocket::close_code::too_big) || tooBig == 0) << tooBig;
 
