@@ -27,10 +27,4 @@ HapticSample sampleOf(double time, const HapticFrame& frame, const std::array<bo
   return sanitised(sample);
 }
 
-std::string_view fingerName(Finger finger) {
-  static constexpr std::array<std::string_view, kFingerCount> kNames{"thumb", "index", "middle", "ring", "little"};
-  const int i = static_cast<int>(finger);
-  return i >= 0 && i < kFingerCount ? kNames[i] : std::string_view("finger?");
-}
-
 }  // namespace vrd

@@ -59,9 +59,9 @@ std::vector<float> recordedOutputs(const HapticFrame& frame) {
 std::string recordedOutputName(std::size_t j) {
   if (j == 0) return "paper";
   if (j == 1) return "paper raw";
-  constexpr std::array<const char*, kFingerCount> fingers{"thumb", "index", "middle", "ring", "little"};
   constexpr std::array<const char*, 4> kinds{"force", "raw", "newtons", "baseline"};
-  if (j - 2 < std::size_t(4 * kFingerCount)) return fmt::format("{} {}", fingers[(j - 2) / 4], kinds[(j - 2) % 4]);
+  if (j - 2 < std::size_t(4 * kFingerCount))
+    return fmt::format("{} {}", fingerName(Finger((j - 2) / 4)), kinds[(j - 2) % 4]);
   return fmt::format("output {}", j);
 }
 

@@ -33,9 +33,6 @@ HapticSample sanitised(const HapticSample& sample);
 /// absent fingers) and the paper's value, sanitised.
 HapticSample sampleOf(double time, const HapticFrame& frame, const std::array<bool, kFingerCount>& present);
 
-/// "thumb", "index", "middle", "ring", "little": the names in file headers and docs.
-std::string_view fingerName(Finger finger);
-
 /// A destination for the haptic signal. Implementations are used from one thread at a time; send()
 /// never throws (I/O errors are counted and reported by the implementation) and never blocks for long.
 class HapticOutput {

@@ -7,6 +7,7 @@
 // side, +z out of the palm. Fingers curl towards +z; the thumb curls across the palm towards -y.
 
 #include <array>
+#include <string_view>
 
 #include "vrdeform/math/types.h"
 
@@ -14,6 +15,13 @@ namespace vrd {
 
 enum class Finger { Thumb, Index, Middle, Ring, Little };
 inline constexpr int kFingerCount = 5;
+
+/// "thumb", "index", "middle", "ring", "little": the names in file headers, messages and docs.
+constexpr std::string_view fingerName(Finger finger) {
+  constexpr std::array<std::string_view, kFingerCount> kNames{"thumb", "index", "middle", "ring", "little"};
+  const int i = static_cast<int>(finger);
+  return i >= 0 && i < kFingerCount ? kNames[std::size_t(i)] : std::string_view("finger?");
+}
 
 struct FingerGeometry {
   Vec3 knuckle;                   ///< base joint in the wrist frame
