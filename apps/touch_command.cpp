@@ -468,7 +468,7 @@ int touch(const TouchArgs& a, const std::string& version) {
   }
   const StopSignals signals;
   const auto afterStep = [&](std::uint64_t k) {
-    const HapticSample sample = sampleOf(double(k + 1) / s.rate, session.haptics(), settings.hand.fingers);
+    const HapticSample sample = sampleOf(k + 1, session);
     for (const auto& out : outputs) out->send(sample);
     if (glove) glove->afterStep(session.haptics(), double(k + 1) / s.rate);  // real time
     return !signals.requested();

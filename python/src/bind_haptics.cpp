@@ -23,6 +23,8 @@ void bindHaptics(py::module_& m) {
       .def_readonly("newtons", &FingerHaptics::newtons, "the force between fingertip and body (N)")
       .def_readonly("baseline", &FingerHaptics::baseline, "the vendor-style baseline (condition B) in [0, 1]")
       .def_readonly("contacts", &FingerHaptics::contacts, "contacts that pushed in the last substep")
+      .def_readonly("depth", &FingerHaptics::depth,
+                    "indentation (m): how far the fingertip has gone in since this touch began, along its first push")
       .def("__repr__", [](const FingerHaptics& f) {
         return fmt::format("FingerHaptics(force={:.4f}, newtons={:.4f}, contacts={})", f.force, f.newtons, f.contacts);
       });

@@ -25,7 +25,8 @@ def test_a_run_matches_the_command_line_program_bit_for_bit(cli, tmp_path):
 
     def record(step):
         h = step["haptics"]
-        rows.append((h.paper, h.finger(vrdeform.Finger.INDEX).force, h.finger(vrdeform.Finger.INDEX).newtons))
+        index = h.finger(vrdeform.Finger.INDEX)
+        rows.append((h.paper, index.force, index.newtons, index.depth))
 
     summary = scene.run(steps=steps, callback=record)
     assert summary["ok"] and summary["steps"] == steps and len(rows) == steps
@@ -34,11 +35,16 @@ def test_a_run_matches_the_command_line_program_bit_for_bit(cli, tmp_path):
     subprocess.run([str(cli), "run", "liver", "--steps", str(steps), "--out", str(tmp_path)],
                    check=True, capture_output=True)
     with open(tmp_path / "forces.csv") as f:
-        expected = [(float(r["paper"]), float(r["index"]), float(r["index_N"])) for r in csv.DictReader(f)]
+        table = list(csv.DictReader(f))
+    expected = [(float(r["paper"]), float(r["index"]), float(r["index_N"]), float(r["index_depth_m"])) for r in table]
     assert len(expected) == steps
+    dt = scene.spec.solver.time_step
+    assert [int(r["step"]) for r in table] == list(range(1, steps + 1))
+    assert all(float(r["time_s"]) == int(r["step"]) * dt for r in table)  # step x dt, exactly
     got = np.array(rows, dtype=np.float32)
     want = np.array(expected, dtype=np.float32)
     assert np.any(want[:, 2] > 0.5), "the poke reached the liver"
+    assert 0.002 < want[:, 3].max() < 0.03, "the index went millimetres into the liver"
     np.testing.assert_array_equal(got, want)
 
 

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
+#include <string_view>
 #include <system_error>
 #include <utility>
 
@@ -19,6 +20,9 @@ namespace vrd {
 namespace {
 
 constexpr std::size_t kFlushBytes = 64 * 1024;  // write early when this much is waiting
+// Each present finger's columns, after its name (docs/outputs.md).
+constexpr std::string_view kFingerColumns[] = {"",          "_N", "_raw", "_baseline", "_depth_m",
+                                               "_contacts", "_x", "_y",   "_z"};
 
 template <typename T>
 void appendNumber(std::string& out, T value) {
@@ -48,11 +52,10 @@ CsvRecorder::CsvRecorder(std::filesystem::path path, const std::array<bool, kFin
   } while (fd_ < 0 && errno == EINTR);
   if (fd_ < 0) throw Error(fmt::format("cannot write {}: {}", path_.string(), errnoText(errno)));
 
-  header_ = "time_s,wall_ms,paper";
+  header_ = "step,time_s,wall_ms,paper,paper_raw,grasp";
   for (int f = 0; f < kFingerCount; ++f)
-    if (present_[f]) (header_ += ',') += fingerName(Finger(f));
-  for (int f = 0; f < kFingerCount; ++f)
-    if (present_[f]) ((header_ += ',') += fingerName(Finger(f))) += "_N";
+    if (present_[f])
+      for (std::string_view column : kFingerColumns) header_ += fmt::format(",{}{}", fingerName(Finger(f)), column);
   buffer_.reserve(kFlushBytes + 1024);  // rows are appended without allocating
   buffer_.append(header_);
   buffer_ += '\n';
@@ -71,6 +74,7 @@ void CsvRecorder::send(const HapticSample& sample) {
   const auto now = std::chrono::steady_clock::now();
   const HapticSample s = sanitised(sample);
   lastTime_ = s.time;
+  lastStep_ = s.step;
   anySample_ = true;
   releasedRow_ = false;
   if (failed()) {
@@ -84,6 +88,7 @@ void CsvRecorder::send(const HapticSample& sample) {
 void CsvRecorder::release() {
   if (anySample_ && !releasedRow_) {
     HapticSample zero;
+    zero.step = lastStep_;
     zero.time = lastTime_;
     zero.present = present_;
     if (failed())
@@ -101,20 +106,22 @@ void CsvRecorder::flush() {
 }
 
 void CsvRecorder::appendRow(const HapticSample& s, std::chrono::steady_clock::time_point now) {
-  appendNumber(buffer_, s.time);
+  const auto field = [&](auto value) {
+    buffer_ += ',';
+    appendNumber(buffer_, value);
+  };
+  appendNumber(buffer_, s.step);
+  field(s.time);
   buffer_ += ',';
   appendMilliseconds(buffer_, now - start_);
-  buffer_ += ',';
-  appendNumber(buffer_, s.paper);
+  field(s.paper);
+  field(s.paperRaw);
+  buffer_ += s.grasp ? ",1" : ",0";
   for (int f = 0; f < kFingerCount; ++f) {
     if (!present_[f]) continue;
-    buffer_ += ',';
-    appendNumber(buffer_, s.force[f]);
-  }
-  for (int f = 0; f < kFingerCount; ++f) {
-    if (!present_[f]) continue;
-    buffer_ += ',';
-    appendNumber(buffer_, s.newtons[f]);
+    for (const float v : {s.force[f], s.newtons[f], s.raw[f], s.baseline[f], s.depth[f]}) field(v);
+    field(s.contacts[f]);
+    for (int axis = 0; axis < 3; ++axis) field(s.tip[f][axis]);
   }
   buffer_ += '\n';
   ++bufferRows_;

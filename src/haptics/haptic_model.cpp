@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "vrdeform/error.h"
@@ -107,10 +108,19 @@ const HapticFrame& HapticModel::update(const World& world, const HandRig& rig, c
     out.raw = rawHapticForce(holding, count, normalisedContact(lambdaSum, count > 0 ? 1 : 0, s.tauFingerContact),
                              count > 0 || holding ? volumeStrain(centre) : 0.0f, s);
     out.force = limitChange(out.force, smoothHapticForce(out.force, out.raw, s.alphaT), maxStep);
+    const Vec3 push = world.fingertipForce(tip);  // on the body: into it
+    // The indentation, along the first push of this touch: the surface's normal where it began
+    // (later pushes tilt with friction and the body's give).
+    Touch& touch = touches_[f];
+    if (count == 0) touch = {};
+    if (count > 0 && !touch.began) touch = {true, centre, Vec3::Zero()};
+    if (const float n = push.norm(); count > 0 && touch.along.isZero() && n > 0.0f && std::isfinite(n))
+      touch.along = push / n;
+    out.depth = std::max(0.0f, (centre - touch.at).dot(touch.along));
     out.contacts = count;
 
     if (!holding)
-      out.newtons = world.fingertipForce(tip).norm();
+      out.newtons = push.norm();
     else if (grasp.settings().mode == GraspMode::Local)
       out.newtons = grasp.holdForce(world, Finger(f)).norm();
     else  // eq. 35 prescribes the body: the hand carries its weight, shared by the pinching fingers

@@ -111,10 +111,10 @@ class RunFiles {
     }
   }
 
-  // One step; `session` is null in a scene without a hand (the force trace then stays empty).
-  void step(const BuiltScene& scene, const HapticSession* session, const StageTimes& times, std::uint64_t k, double t,
+  // One step; `sample` is null in a scene without a hand (the force trace then stays empty).
+  void step(const BuiltScene& scene, const HapticSample* sample, const StageTimes& times, std::uint64_t k, double t,
             bool contact) {
-    if (session) forces_->send(sampleOf(t, session->haptics(), fingers_));
+    if (sample) forces_->send(*sample);
     stageCsv_->print("{},{:.6f},{}", k, t, contact ? "contact" : "idle");
     for (double ms : times.ms) stageCsv_->print(",{:.5f}", ms);
     stageCsv_->print(",{:.5f}\n", times.totalMs());
@@ -282,10 +282,11 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
       summary.volumeLossFinal = loss;
       summary.steps = k + 1;
 
+      std::optional<HapticSample> sample;
       if (session) {
         const HapticFrame& h = session->haptics();
-        const HapticSample sample = sampleOf(t, h, summary.fingers);
-        for (HapticOutput* out : settings.outputs) out->send(sample);
+        sample = sampleOf(k + 1, *session);
+        for (HapticOutput* out : settings.outputs) out->send(*sample);
         summary.paperMax = std::max(summary.paperMax, h.paper);
         for (int f = 0; f < kFingerCount; ++f) {
           summary.forceMax[f] = std::max(summary.forceMax[f], h.fingers[f].force);
@@ -311,7 +312,7 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
           for (auto& [grasp, held] : grasps) held += began >= grasp->start && began < grasp->end();
         traces.add(t, h, session->rig(), poking);
       }
-      if (files) files->step(scene, session ? &*session : nullptr, times, k, t, contact);
+      if (files) files->step(scene, sample ? &*sample : nullptr, times, k, t, contact);
       if (settings.afterStep &&
           !settings.afterStep(RunStep{k, t, session ? &*session : nullptr, &times, loss, summary.nanEvents}))
         break;

@@ -193,7 +193,7 @@ void SimulationLoop::step(std::uint64_t k) {
   if (session_) {
     session_->step(input_ ? input_->frame(k, double(k) * dt_) : HandFrame{});
     contact_ = session_->inContact();
-    const HapticSample sample = sampleOf(double(k + 1) * dt_, session_->haptics(), scene_.session.hand.fingers);
+    const HapticSample sample = sampleOf(k + 1, *session_);
     for (HapticOutput* out : settings_.outputs) out->send(sample);
   } else {
     world.step();

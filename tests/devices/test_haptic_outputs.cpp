@@ -39,16 +39,33 @@ constexpr std::array<bool, kFingerCount> kPro{true, true, true, true, true};
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+// Every field set, each finger's values different: a column in the wrong place shows.
 HapticSample makeSample(double time, const std::array<bool, kFingerCount>& present, float scale = 1.0f) {
   HapticSample s;
+  s.step = std::uint64_t(std::llround(time * 60.0));
   s.time = time;
   s.present = present;
   s.paper = 0.5f * scale;
+  s.paperRaw = 0.625f * scale;
+  s.grasp = scale == 1.0f;
   for (int f = 0; f < kFingerCount; ++f) {
     s.force[f] = 0.1f * float(f + 1) * scale;
     s.newtons[f] = 1.5f * float(f + 1) * scale;
+    s.raw[f] = 0.125f * float(f + 1) * scale;
+    s.baseline[f] = 0.0625f * float(f + 1) * scale;
+    s.depth[f] = 1e-3f * float(f + 1) * scale;
+    s.contacts[f] = std::uint32_t(f + 2);
+    s.tip[f] = Vec3(0.01f * float(f), -0.02f, 0.25f * scale);
   }
   return s;
+}
+
+// The header `run --out` and `--forces` write for `fingers` (docs/outputs.md).
+std::string csvHeader(const std::vector<std::string>& fingers) {
+  std::string h = "step,time_s,wall_ms,paper,paper_raw,grasp";
+  for (const std::string& f : fingers)
+    for (const char* c : {"", "_N", "_raw", "_baseline", "_depth_m", "_contacts", "_x", "_y", "_z"}) h += "," + f + c;
+  return h;
 }
 
 // --- files -------------------------------------------------------------------------------------
@@ -92,25 +109,35 @@ double number(const std::string& field) {
 TEST(HapticOutputs, SampleOfTakesPresentFingersAndSanitises) {
   HapticFrame frame;
   frame.paper = kNaN;
-  frame.fingers[0] = {0.25f, 0.3f, 2.0f, 0.1f, 3};
-  frame.fingers[1] = {1.5f, 0.0f, kInf, 0.0f, 1};
-  frame.fingers[2] = {-0.5f, 0.0f, -3.0f, 0.0f, 0};
-  frame.fingers[3] = {0.75f, 0.0f, 4.0f, 0.0f, 2};  // absent on a G1 hand
-  const HapticSample s = sampleOf(1.25, frame, kG1);
-  EXPECT_EQ(s.time, 1.25);
+  frame.paperRaw = 0.75f;
+  frame.fingers[0] = {0.25f, 0.3f, 2.0f, 0.1f, 3, 0.004f};
+  frame.fingers[1] = {1.5f, 0.0f, kInf, 0.0f, 1, kNaN};
+  frame.fingers[2] = {-0.5f, 0.0f, -3.0f, 0.0f, 0, -1.0f};
+  frame.fingers[3] = {0.75f, 0.0f, 4.0f, 0.0f, 2, 0.5f};  // absent on a G1 hand
+  const HapticSample s = sampleOf(75, 1.0 / 60.0, frame, kG1);
+  EXPECT_EQ(s.step, 75u);
+  EXPECT_EQ(s.time, 75 * (1.0 / 60.0));  // step x dt, not a sum of dt
   EXPECT_EQ(s.paper, 0.0f);
+  EXPECT_EQ(s.paperRaw, 0.75f);
   EXPECT_EQ(s.present, kG1);
   EXPECT_EQ(s.force, (std::array<float, kFingerCount>{0.25f, 1.0f, 0.0f, 0.0f, 0.0f}));
   EXPECT_EQ(s.newtons, (std::array<float, kFingerCount>{2.0f, 0.0f, 0.0f, 0.0f, 0.0f}));
+  EXPECT_EQ(s.raw, (std::array<float, kFingerCount>{0.3f, 0.0f, 0.0f, 0.0f, 0.0f}));
+  EXPECT_EQ(s.baseline, (std::array<float, kFingerCount>{0.1f, 0.0f, 0.0f, 0.0f, 0.0f}));
+  EXPECT_EQ(s.depth, (std::array<float, kFingerCount>{0.004f, 0.0f, 0.0f, 0.0f, 0.0f}));
+  EXPECT_EQ(s.contacts, (std::array<std::uint32_t, kFingerCount>{3, 1, 0, 0, 0}));
 
   HapticSample bad = makeSample(std::numeric_limits<double>::infinity(), kPro);
   bad.force[4] = -kInf;
   bad.newtons[4] = kNaN;
+  bad.tip[4] = Vec3(kNaN, 1.0f, kInf);
   const HapticSample clean = sanitised(bad);
   EXPECT_EQ(clean.time, 0.0);
   EXPECT_EQ(clean.force[4], 0.0f);
   EXPECT_EQ(clean.newtons[4], 0.0f);
+  EXPECT_EQ(clean.tip[4], Vec3(0.0f, 1.0f, 0.0f));
   EXPECT_EQ(clean.force[1], bad.force[1]);
+  EXPECT_EQ(clean.tip[1], bad.tip[1]);
   EXPECT_EQ(fingerName(Finger::Little), "little");
 }
 
@@ -119,29 +146,39 @@ TEST(HapticOutputs, SampleOfTakesPresentFingersAndSanitises) {
 TEST(CsvRecorder, HeaderAndRowsForG1Hand) {
   TempDir dir;
   const fs::path path = dir / "g1.csv";
+  const std::string header = csvHeader({"thumb", "index", "middle"});
   {
     CsvRecorder recorder(path, kG1);
-    EXPECT_EQ(recorder.header(), "time_s,wall_ms,paper,thumb,index,middle,thumb_N,index_N,middle_N");
+    EXPECT_EQ(recorder.header(), header);
     recorder.send(makeSample(0.0, kG1));
     recorder.send(makeSample(1.0 / 60.0, kG1, 0.5f));
     EXPECT_FALSE(recorder.failed());
   }
   const auto lines = splitLines(readFile(path));
   ASSERT_EQ(lines.size(), 3u);
-  EXPECT_EQ(lines[0], "time_s,wall_ms,paper,thumb,index,middle,thumb_N,index_N,middle_N");
+  EXPECT_EQ(lines[0], header);
   for (int row = 0; row < 2; ++row) {
     const auto fields = splitFields(lines[1 + row]);
-    ASSERT_EQ(fields.size(), 9u) << lines[1 + row];
+    ASSERT_EQ(fields.size(), 6u + 3u * 9u) << lines[1 + row];
     const HapticSample expected = makeSample(row == 0 ? 0.0 : 1.0 / 60.0, kG1, row == 0 ? 1.0f : 0.5f);
-    EXPECT_EQ(number(fields[0]), expected.time);  // shortest form reads back exactly
-    EXPECT_GE(number(fields[1]), 0.0);            // wall_ms
-    EXPECT_EQ(float(number(fields[2])), expected.paper);
+    EXPECT_EQ(number(fields[0]), double(expected.step));
+    EXPECT_EQ(number(fields[1]), expected.time);  // shortest form reads back exactly
+    EXPECT_GE(number(fields[2]), 0.0);            // wall_ms
+    EXPECT_EQ(float(number(fields[3])), expected.paper);
+    EXPECT_EQ(float(number(fields[4])), expected.paperRaw);
+    EXPECT_EQ(fields[5], expected.grasp ? "1" : "0");
     for (int f = 0; f < 3; ++f) {
-      EXPECT_EQ(float(number(fields[3 + f])), expected.force[f]);
-      EXPECT_EQ(float(number(fields[6 + f])), expected.newtons[f]);
+      const std::size_t at = 6 + 9 * std::size_t(f);
+      EXPECT_EQ(float(number(fields[at])), expected.force[f]);
+      EXPECT_EQ(float(number(fields[at + 1])), expected.newtons[f]);
+      EXPECT_EQ(float(number(fields[at + 2])), expected.raw[f]);
+      EXPECT_EQ(float(number(fields[at + 3])), expected.baseline[f]);
+      EXPECT_EQ(float(number(fields[at + 4])), expected.depth[f]);
+      EXPECT_EQ(number(fields[at + 5]), double(expected.contacts[f]));
+      for (int axis = 0; axis < 3; ++axis) EXPECT_EQ(float(number(fields[at + 6 + axis])), expected.tip[f][axis]);
     }
   }
-  EXPECT_LE(number(splitFields(lines[1])[1]), number(splitFields(lines[2])[1]));  // wall clock goes forward
+  EXPECT_LE(number(splitFields(lines[1])[2]), number(splitFields(lines[2])[2]));  // wall clock goes forward
 }
 
 TEST(CsvRecorder, HeaderAndRowsForProHand) {
@@ -153,13 +190,15 @@ TEST(CsvRecorder, HeaderAndRowsForProHand) {
   }
   const auto lines = splitLines(readFile(path));
   ASSERT_EQ(lines.size(), 2u);
-  EXPECT_EQ(lines[0], "time_s,wall_ms,paper,thumb,index,middle,ring,little,thumb_N,index_N,middle_N,ring_N,little_N");
+  EXPECT_EQ(lines[0], csvHeader({"thumb", "index", "middle", "ring", "little"}));
   const auto fields = splitFields(lines[1]);
-  ASSERT_EQ(fields.size(), 13u);
-  EXPECT_EQ(fields[0], "2.5");
-  EXPECT_EQ(fields[2], "0.5");
-  EXPECT_EQ(float(number(fields[7])), 0.5f);   // little: 0.1 * 5
-  EXPECT_EQ(float(number(fields[12])), 7.5f);  // little_N: 1.5 * 5
+  ASSERT_EQ(fields.size(), 6u + 5u * 9u);
+  EXPECT_EQ(fields[0], "150");
+  EXPECT_EQ(fields[1], "2.5");
+  EXPECT_EQ(fields[3], "0.5");
+  EXPECT_EQ(float(number(fields[6 + 4 * 9])), 0.5f);      // little: 0.1 * 5
+  EXPECT_EQ(float(number(fields[6 + 4 * 9 + 1])), 7.5f);  // little_N: 1.5 * 5
+  EXPECT_EQ(fields[6 + 4 * 9 + 5], "6");                  // little_contacts
 }
 
 TEST(CsvRecorder, WritesNaNAndOutOfRangeValuesClamped) {
@@ -171,19 +210,24 @@ TEST(CsvRecorder, WritesNaNAndOutOfRangeValuesClamped) {
     s.paper = 3.0f;
     s.force = {kNaN, -0.25f, 7.0f, 0.0f, 0.0f};
     s.newtons = {kInf, kNaN, -2.0f, 0.0f, 0.0f};
+    s.depth[0] = kNaN;
+    s.tip[2] = Vec3(kInf, kNaN, 0.5f);
     recorder.send(s);
   }
   const auto lines = splitLines(readFile(path));
   ASSERT_EQ(lines.size(), 2u);
   const auto fields = splitFields(lines[1]);
-  ASSERT_EQ(fields.size(), 9u);
-  EXPECT_EQ(fields[2], "1");  // paper 3 -> 1
-  EXPECT_EQ(fields[3], "0");  // NaN -> 0
-  EXPECT_EQ(fields[4], "0");  // -0.25 -> 0
-  EXPECT_EQ(fields[5], "1");  // 7 -> 1
-  EXPECT_EQ(fields[6], "0");  // inf N -> 0
-  EXPECT_EQ(fields[7], "0");  // NaN N -> 0
-  EXPECT_EQ(fields[8], "0");  // negative N -> 0
+  ASSERT_EQ(fields.size(), 6u + 3u * 9u);
+  EXPECT_EQ(fields[3], "1");           // paper 3 -> 1
+  EXPECT_EQ(fields[6], "0");           // thumb NaN -> 0
+  EXPECT_EQ(fields[7], "0");           // thumb inf N -> 0
+  EXPECT_EQ(fields[10], "0");          // thumb NaN depth -> 0
+  EXPECT_EQ(fields[6 + 9], "0");       // index -0.25 -> 0
+  EXPECT_EQ(fields[6 + 9 + 1], "0");   // index NaN N -> 0
+  EXPECT_EQ(fields[6 + 18], "1");      // middle 7 -> 1
+  EXPECT_EQ(fields[6 + 18 + 1], "0");  // middle negative N -> 0
+  EXPECT_EQ(fields[6 + 18 + 6], "0");  // middle x inf -> 0
+  EXPECT_EQ(fields[6 + 18 + 8], "0.5");
   EXPECT_EQ(lines[1].find("nan"), std::string::npos) << lines[1];
   EXPECT_EQ(lines[1].find("inf"), std::string::npos) << lines[1];
 }
@@ -208,8 +252,8 @@ TEST(CsvRecorder, FileIsCompleteAfterDestruction) {
   }
   const auto lines = splitLines(readFile(path));
   ASSERT_EQ(lines.size(), std::size_t(kRows) + 1);
-  for (std::size_t i = 1; i < lines.size(); ++i) ASSERT_EQ(splitFields(lines[i]).size(), 13u) << "line " << i;
-  EXPECT_EQ(number(splitFields(lines.back())[0]), (kRows - 1) * 0.001);
+  for (std::size_t i = 1; i < lines.size(); ++i) ASSERT_EQ(splitFields(lines[i]).size(), 51u) << "line " << i;
+  EXPECT_EQ(number(splitFields(lines.back())[1]), (kRows - 1) * 0.001);
 }
 
 TEST(CsvRecorder, FlushesPeriodicallyAndOnRelease) {
@@ -229,8 +273,9 @@ TEST(CsvRecorder, FlushesPeriodicallyAndOnRelease) {
   const auto lines = splitLines(readFile(held));
   ASSERT_EQ(lines.size(), 3u);
   const auto zero = splitFields(lines[2]);
-  EXPECT_EQ(zero[0], "0.25");  // at the last sample's time
-  for (std::size_t i = 2; i < zero.size(); ++i) EXPECT_EQ(zero[i], "0") << i;
+  EXPECT_EQ(zero[0], "15");    // at the last sample's step
+  EXPECT_EQ(zero[1], "0.25");  // and time
+  for (std::size_t i = 3; i < zero.size(); ++i) EXPECT_EQ(zero[i], "0") << i;
   EXPECT_EQ(hourly.rowsWritten(), 2u);
 }
 
@@ -290,7 +335,7 @@ TEST(CsvRecorder, DiskFullDuringRunIsReportedNotThrown) {
   EXPECT_LE(text.size(), 2000u);
   const auto lines = splitLines(text);  // every line whole: the partial row was cut off
   ASSERT_EQ(lines.size(), written + 1);
-  for (std::size_t i = 1; i < lines.size(); ++i) EXPECT_EQ(splitFields(lines[i]).size(), 13u) << lines[i];
+  for (std::size_t i = 1; i < lines.size(); ++i) EXPECT_EQ(splitFields(lines[i]).size(), 51u) << lines[i];
 }
 
 // --- OSC -----------------------------------------------------------------------------------------
@@ -535,16 +580,17 @@ TEST(HapticOutputs, OneSignalToSeveralOutputs) {
   frame.paper = 0.4f;
   frame.fingers[1].force = 0.6f;
   frame.fingers[1].newtons = 1.2f;
-  for (auto& out : outputs) out->send(sampleOf(0.1, frame, kG1));
+  const HapticSample sample = sampleOf(6, 1.0 / 60.0, frame, kG1);
+  for (auto& out : outputs) out->send(sample);
   for (auto& out : outputs) out->release();
   outputs.clear();
   const auto lines = splitLines(readFile(dir / "both.csv"));
-  ASSERT_EQ(lines.size(), 3u);  // header, the sample, the release
-  EXPECT_EQ(splitFields(lines[1])[4], "0.6");
+  ASSERT_EQ(lines.size(), 3u);                     // header, the sample, the release
+  EXPECT_EQ(splitFields(lines[1])[6 + 9], "0.6");  // index
   const auto got = receiver.take(8);
   ASSERT_EQ(got.size(), 8u);
-  expectSample(got, 0, "/vrdeform", sampleOf(0.1, frame, kG1));
-  expectSample(got, 4, "/vrdeform", zerosAt(0.1));
+  expectSample(got, 0, "/vrdeform", sample);
+  expectSample(got, 4, "/vrdeform", zerosAt(sample.time));
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <numeric>
+#include <optional>
 #include <vector>
 
 #include "test_support.h"
@@ -237,6 +238,7 @@ TEST(HapticSession, LiverPokeForceRisesWithDepthAndReturnsToZero) {
   const int load = 180, hold = 30, unload = 60, away = 60;
   std::vector<double> depth, finger, newtons, paper;
   std::vector<float> baseline;
+  std::optional<float> touchedAt;  // the poke's depth at its first contact
   for (int k = 1; k <= load + hold + unload + away; ++k) {
     float d = 0.015f;
     if (k <= load) d = -0.005f + 0.02f * float(k) / load;
@@ -244,6 +246,10 @@ TEST(HapticSession, LiverPokeForceRisesWithDepthAndReturnsToZero) {
     const HapticFrame& f = session.step(pokeAt(liver, d));
     const FingerHaptics& index = f.fingers[int(Finger::Index)];
     if (k <= load && index.contacts > 0) {
+      // The indentation: the fingertip's travel since it touched, along the body's push (here
+      // about vertical: a few degrees' tilt of the surface under it costs a few percent).
+      if (!touchedAt) touchedAt = d;
+      EXPECT_NEAR(index.depth, d - *touchedAt, 0.05f * (d - *touchedAt) + 2e-4f) << "step " << k;
       depth.push_back(d);
       finger.push_back(index.force);
       newtons.push_back(index.newtons);
@@ -254,6 +260,7 @@ TEST(HapticSession, LiverPokeForceRisesWithDepthAndReturnsToZero) {
       EXPECT_EQ(index.contacts, 0u);
       EXPECT_EQ(index.raw, 0.0f);
       EXPECT_EQ(index.baseline, 0.0f);
+      EXPECT_EQ(index.depth, 0.0f);
     }
   }
   ASSERT_GT(depth.size(), 100u);

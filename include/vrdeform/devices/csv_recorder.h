@@ -1,12 +1,16 @@
 #pragma once
-// Records the haptic signal to a CSV file, one row per sample:
+// Records the haptic signal to a CSV file, one row per sample; the one per-step schema of every
+// command (`run --out`'s forces.csv, `--forces` on run and touch; docs/outputs.md):
 //
-//   time_s,wall_ms,paper,thumb,index,middle,thumb_N,index_N,middle_N     (a G1 hand)
+//   step,time_s,wall_ms,paper,paper_raw,grasp, then per present finger F:
+//   F,F_N,F_raw,F_baseline,F_depth_m,F_contacts,F_x,F_y,F_z
 //
-// time_s is the simulation time, wall_ms the steady-clock time since the recorder was made, then
-// the paper's hand value, the normalised force of each present finger and its force in newtons.
-// Numbers are written with std::to_chars (shortest form that reads back exactly, '.' whatever the
-// locale); wall_ms with three decimals.
+// step counts the steps done and time_s is step x dt (the simulation time); wall_ms the
+// steady-clock time since the recorder was made; paper and paper_raw Algorithm 2's value for the
+// hand and its F_raw; grasp 1 while a grasp holds the body. Per finger: the normalised force the
+// glove gets, the force in newtons, F_raw, the condition B baseline, the indentation in metres,
+// the contacts that pushed and the fingertip centre (m). Numbers are written with std::to_chars
+// (shortest form that reads back exactly, '.' whatever the locale); wall_ms with three decimals.
 //
 // Streaming, not all-or-nothing: rows are collected in memory and written to the file itself,
 // whole rows at a time, at least every `flushInterval`, on flush(), release() and destruction. A
@@ -16,6 +20,7 @@
 #include <array>
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -67,6 +72,7 @@ class CsvRecorder final : public HapticOutput {
   std::size_t fileBytes_ = 0;   // bytes of whole lines in the file
   std::size_t rowsWritten_ = 0, rowsDropped_ = 0;
   double lastTime_ = 0.0;
+  std::uint64_t lastStep_ = 0;
   bool anySample_ = false, releasedRow_ = false;
   std::string error_;
 };

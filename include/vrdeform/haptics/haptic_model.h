@@ -35,6 +35,10 @@ struct FingerHaptics {
   float newtons = 0.0f;      ///< magnitude of the force between fingertip and body (N)
   float baseline = 0.0f;     ///< condition B value in [0, 1]
   std::size_t contacts = 0;  ///< contacts that pushed in the last substep
+  /// Indentation (m): how far the fingertip has gone into the body since this touch began, along
+  /// the direction of its first push (the surface's normal there; a slide across it does not
+  /// count); 0 in the air.
+  float depth = 0.0f;
 };
 
 struct HapticFrame {
@@ -52,7 +56,7 @@ class HapticModel {
   const HapticFrame& frame() const { return frame_; }
   const HapticSettings& settings() const { return settings_; }
   /// Zeroes the outputs (e.g. when the session stops or the glove reconnects).
-  void reset() { frame_ = {}; }
+  void reset() { frame_ = {}, touches_ = {}; }
 
  private:
   void gatherTets(const World& world);
@@ -60,6 +64,12 @@ class HapticModel {
 
   HapticSettings settings_;
   HapticFrame frame_;
+  struct Touch {
+    bool began = false;
+    Vec3 at = Vec3::Zero();     // the fingertip's centre when it began
+    Vec3 along = Vec3::Zero();  // its first push's direction (zero until it pushed)
+  };
+  std::array<Touch, kFingerCount> touches_{};
   TetSignals tets_;  // every tet of every active body, this step
 };
 
