@@ -835,4 +835,13 @@ SceneSpec loadScene(const fs::path& path) {
   return scene;
 }
 
+SceneSpec sceneOfMesh(const fs::path& mesh) {
+  const toml::table root{{"body", toml::array{toml::table{{"mesh", mesh.string()}}}}};
+  std::error_code error;
+  const Context ctx{mesh.string(), fs::current_path(error)};
+  SceneSpec scene = readScene(Table(ctx, root, "", 1), mesh.string());
+  scene.source = scene.bodies.front().mesh;
+  return scene;
+}
+
 }  // namespace vrd

@@ -20,4 +20,9 @@ SceneSpec parseScene(std::string_view text, std::string_view sourceName, const s
 /// a file it cannot read.
 SceneSpec loadScene(const std::filesystem::path& path);
 
+/// The scene of a file that says only `[[body]] mesh = "MESH"`: the mesh (relative to the current
+/// folder) on the ground with the scene files' defaults (soft tissue, settled to rest, the hand).
+/// Named after the mesh's stem; throws vrd::Error as parseScene does.
+SceneSpec sceneOfMesh(const std::filesystem::path& mesh);
+
 }  // namespace vrd
