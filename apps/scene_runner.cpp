@@ -231,7 +231,8 @@ std::optional<SessionRecording> loadReplay(const RunOptions& o, std::string_view
   return recording;
 }
 
-int runSceneCommand(const SceneSpec& spec, const RunOptions& a, std::vector<std::pair<std::string, std::string>> recorded,
+int runSceneCommand(const SceneSpec& spec, const RunOptions& a,
+                    std::vector<std::pair<std::string, std::string>> recorded,
                     std::optional<SessionRecording> replaying) {
   if (a.render && a.out.empty()) throw Error("--render needs --out DIR for the frames");
   if ((replaying || !a.record.empty()) && !spec.hand.enabled)

@@ -1,5 +1,7 @@
 #include "viewer.h"
 
+#include "../build_observer.h"
+
 #include <epoxy/gl.h>
 // GLFW after epoxy, which must come before any other OpenGL header.
 #include <GLFW/glfw3.h>
@@ -45,8 +47,8 @@ struct Running {
   SceneRenderer renderer;
   MouseHand mouse;
 
-  explicit Running(const SceneSpec& spec)
-      : scene(buildScene(spec)),
+  Running(const SceneSpec& spec, const SceneBuildObserver& observer)
+      : scene(buildScene(spec, observer)),
         posed(scene),
         renderer(posed),
         mouse(spec.hand.rig.geometry.fingertipRadius, parkAbove(scene)) {}
@@ -59,8 +61,8 @@ struct Running {
   }
 };
 
-std::unique_ptr<Running> start(const SceneSpec& spec, const std::string& weart) {
-  auto r = std::make_unique<Running>(spec);
+std::unique_ptr<Running> start(const SceneSpec& spec, const SceneBuildObserver& observer, const std::string& weart) {
+  auto r = std::make_unique<Running>(spec, observer);
   r->mouseInput.set(r->mouse.update({}, r->posed, OrbitCamera{}, 0.0f));  // parked
   SimulationLoopSettings settings;
   if (!weart.empty() && spec.hand.enabled) {
@@ -99,7 +101,9 @@ class History {
 
 class Viewer {
  public:
-  Viewer(GLFWwindow* window, const ViewerOptions& options) : window_(window), options_(options) {
+  // Ctrl-C (`signals`) stops a build in any phase (vrd::Stopped) and ends the window's loop.
+  Viewer(GLFWwindow* window, const ViewerOptions& options, const StopSignals& signals)
+      : window_(window), options_(options), signals_(signals), observer_(commandObserver(signals)) {
     render_.colorMap = options.colorMap;
     spec_ = loadSceneByName(options.scene);
     sceneName_ = spec_.name;
@@ -125,6 +129,8 @@ class Viewer {
 
   GLFWwindow* window_;
   ViewerOptions options_;
+  const StopSignals& signals_;
+  SceneBuildObserver observer_;     // prints the build's progress on the terminal; Ctrl-C stops it
   SceneSpec spec_;                  // what the next rebuild builds (the sliders edit it)
   std::optional<SceneSpec> built_;  // what the running scene was built from
   std::string sceneName_;
@@ -149,13 +155,13 @@ void Viewer::rebuild() {
   stopped_ = false;
   glfwSetWindowTitle(window_, fmt::format("vrdeform view: {} (building...)", spec_.name).c_str());
   try {
-    running_ = start(spec_, options_.weart);
+    running_ = start(spec_, observer_, options_.weart);
     built_ = spec_;
   } catch (const Error& e) {  // e.g. a material the builder refuses: back to the last scene that built
     fmt::print(stderr, "vrdeform: cannot rebuild {}: {}\n", spec_.name, e.what());
     if (!built_) throw;
     spec_ = *built_;
-    running_ = start(spec_, options_.weart);
+    running_ = start(spec_, observer_, options_.weart);
     error_ = fmt::format("rebuild refused: {}", e.what());
   }
   glfwSetWindowTitle(window_, fmt::format("vrdeform view: {}", spec_.name).c_str());
@@ -417,11 +423,10 @@ void Viewer::screenshot(int width, int height) const {
 }
 
 int Viewer::run() {
-  const StopSignals signals;
   int frames = 0;
   const Clock::time_point opened = Clock::now();
   Clock::time_point last = opened;
-  while (!glfwWindowShouldClose(window_) && !signals.requested()) {
+  while (!glfwWindowShouldClose(window_) && !signals_.requested()) {
     glfwPollEvents();
     const Clock::time_point now = Clock::now();
     const float dt = std::min(std::chrono::duration<float>(now - last).count(), 0.1f);
@@ -499,7 +504,8 @@ int runViewer(const ViewerOptions& options) {
   ImGui_ImplOpenGL3_Init("#version 330");
   int status = 1;
   try {
-    Viewer viewer(window, options);
+    const StopSignals signals;
+    Viewer viewer(window, options, signals);
     status = viewer.run();
   } catch (...) {
     ImGui_ImplOpenGL3_Shutdown();
