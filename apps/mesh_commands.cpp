@@ -63,6 +63,7 @@ int tetrahedraliseCommand(const TetArgs& a) {
   if (a.tets > 0 && std::abs(double(result.mesh.tets.size()) - double(a.tets)) > options.countTolerance * a.tets)
     fmt::print("note: {} tets is as close to {} as this mesher gets on this surface\n", result.mesh.tets.size(),
                a.tets);
+  if (const std::string dropped = droppedMessage(result); !dropped.empty()) fmt::print("note: {}\n", dropped);
   fmt::print("{}", measureTetQuality(result.mesh, &surface).table());
   if (!a.output.empty()) {
     writeTetMesh(a.output, result.mesh);

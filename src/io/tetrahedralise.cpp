@@ -24,12 +24,13 @@ Tetrahedralisation searchCount(Run&& run, double target, double initialBound, do
   double bound = initialBound, bestMiss = HUGE_VAL;
   double tooMany = 0, tooFew = HUGE_VAL;  // bracket: bounds giving more / fewer tets than wanted
   for (int attempt = 1; attempt <= 12; ++attempt) {
-    TetMesh mesh = run(bound);
-    const double count = std::max<double>(1, mesh.tets.size());
+    Stuffing made = run(bound);
+    const double count = std::max<double>(1, made.mesh.tets.size());
     const double miss = std::abs(count - target) / target;
     if (miss < bestMiss) {
       bestMiss = miss;
-      best.mesh = std::move(mesh);
+      best.mesh = std::move(made.mesh);
+      best.dropped = made.dropped;
       best.maxVolume = bound;
     }
     best.runs = attempt;
@@ -54,7 +55,9 @@ Tetrahedralisation builtin(const TriMesh& surface, double volume, const Tetrahed
                        options.countTolerance / 3);
   Tetrahedralisation r;
   r.maxVolume = options.maxVolume > 0 ? options.maxVolume : volume / 1000;
-  r.mesh = run(r.maxVolume);
+  Stuffing made = run(r.maxVolume);
+  r.mesh = std::move(made.mesh);
+  r.dropped = made.dropped;
   r.runs = 1;
   return r;
 }
@@ -82,7 +85,7 @@ Tetrahedralisation tetgen(const TriMesh& surface, double volume, const Tetrahedr
     if (quality == 0) return floor;  // the target is below what the surface needs
   }
   if (double(floor.mesh.tets.size()) >= target * (1 - options.countTolerance)) return floor;
-  auto run = [&](double bound) { return runTetGen(surface, bound, floor.radiusEdge, options); };
+  auto run = [&](double bound) { return Stuffing{runTetGen(surface, bound, floor.radiusEdge, options), {}}; };
   Tetrahedralisation r = searchCount(run, target, 3 * volume / target, options.countTolerance);
   r.radiusEdge = floor.radiusEdge;
   r.runs += runs;
@@ -97,6 +100,15 @@ Tetrahedralisation tetgen(const TriMesh& surface, double volume, const Tetrahedr
 }
 
 }  // namespace
+
+std::string droppedMessage(const Tetrahedralisation& r) {
+  const DroppedPieces& d = r.dropped;
+  if (d.pieces == 0) return "";
+  return fmt::format(
+      "the mesher dropped {} loose or edge-joined fragment{} of {} tets ({:.2g}% of the volume): a part thinner than "
+      "its lattice cell ({:.3g} across) came out in pieces; more tets keep it",
+      d.pieces, d.pieces == 1 ? "" : "s", d.tets, 100 * d.share, std::cbrt(12 * r.maxVolume));
+}
 
 Tetrahedralisation tetrahedralise(const TriMesh& surface, const TetrahedraliseOptions& options) {
   if (!(options.maxVolume >= 0) || !std::isfinite(options.maxVolume))

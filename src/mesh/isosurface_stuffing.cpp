@@ -245,7 +245,7 @@ void restoreVolume(TetMesh& mesh, double targetVolume) {
 
 }  // namespace
 
-TetMesh stuffIsosurface(const TriMesh& surface, const StuffingOptions& options) {
+Stuffing stuffIsosurface(const TriMesh& surface, const StuffingOptions& options) {
   const double cellSize = options.cellSize;
   const std::size_t maxLatticeVertices = options.maxLatticeVertices;
   if (!(cellSize > 0) || !std::isfinite(cellSize))
@@ -311,8 +311,11 @@ TetMesh stuffIsosurface(const TriMesh& surface, const StuffingOptions& options) 
     }
     mesh.tets.push_back(t);
   }
+  Stuffing result;
+  result.dropped = keepOnePiecePerShell(mesh, surface);
   if (options.preserveVolume && !mesh.tets.empty()) restoreVolume(mesh, enclosedVolume(surface));
-  return mesh;
+  result.mesh = std::move(mesh);
+  return result;
 }
 
 }  // namespace vrd

@@ -70,11 +70,14 @@ PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log, const std::f
     const auto start = std::chrono::steady_clock::now();
     TetrahedraliseOptions mesher = body.mesher;
     mesher.stop = stop;
-    out.tets = tetrahedralise(surface, mesher).mesh;
+    Tetrahedralisation made = tetrahedralise(surface, mesher);
+    out.tets = std::move(made.mesh);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     say(log,
         fmt::format("mesh: {} ({} triangles) x {:g}: {} tets from the {} mesher in {:.2f} s", name,
                     surface.triangles.size(), body.scale, out.tets.tets.size(), toString(body.mesher.mesher), seconds));
+    if (const std::string dropped = droppedMessage(made); !dropped.empty())
+      say(log, fmt::format("note: body '{}': {} (`tets` in the scene file)", body.name, dropped));
   } else {
     out.tets = readTetMesh(body.mesh);
     out.hash = meshHash(out.tets.vertices, out.tets.tets);

@@ -1,5 +1,6 @@
 // Both meshers on every closed shared mesh: positive tets, the surface's volume, counts on
 // request, bounded angles; and TetGen's failures (missing, crashing, hanging, garbage) as errors.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,6 +16,7 @@
 #include "vrdeform/mesh/isosurface_stuffing.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/mesh/surface_check.h"
+#include "vrdeform/mesh/tet_pieces.h"
 #include "vrdeform/mesh/tet_quality.h"
 
 namespace vrd {
@@ -76,6 +78,31 @@ TEST(Tetrahedralise, BuiltinMeshesEveryClosedSharedMeshToTheCountAndVolume) {
   }
 }
 
+TEST(Tetrahedralise, BuiltinGivesOneFaceConnectedPieceAtEveryCount) {
+  // A part thinner than a lattice cell (the bunny's ears) can come out as fragments: loose tets,
+  // or tets joined to the body only along an edge or at a vertex, which would fall off or hinge.
+  // They are dropped and counted; what remains is one piece whose tets all share faces.
+  for (const char* name : kClosedMeshes) {
+    const TriMesh surface = readSurface(kMeshes / name);
+    for (std::size_t target : {700u, 3000u, 5000u}) {
+      SCOPED_TRACE(fmt::format("{} at {} tets", name, target));
+      const Tetrahedralisation r = tetrahedralise(surface, {.mesher = Mesher::Builtin, .targetTets = target});
+      EXPECT_EQ(facePieces(r.mesh).count, 1u);
+      EXPECT_LT(r.dropped.share, 0.01);
+      EXPECT_EQ(droppedMessage(r).empty(), r.dropped.pieces == 0);
+    }
+  }
+  // A cell at which the bunny's thin parts fragment (most cells of about 0.5-1.2 do): the pieces
+  // are found, dropped, counted, and the volume is still the surface's.
+  const TriMesh bunny = readSurface(kMeshes / "bunny.obj");
+  const Stuffing made = stuffIsosurface(bunny, {0.816, true});
+  EXPECT_GE(made.dropped.pieces, 1u);
+  EXPECT_GE(made.dropped.tets, made.dropped.pieces);
+  EXPECT_GT(made.dropped.share, 0.0);
+  EXPECT_EQ(facePieces(made.mesh).count, 1u);
+  EXPECT_NEAR(meshVolume(made.mesh), enclosedVolume(bunny), 1e-3 * enclosedVolume(bunny));
+}
+
 TEST(Tetrahedralise, TetGenMeshesEveryClosedSharedMeshToTheCountAndVolume) {
   ASSERT_TRUE(haveTetGen()) << "TetGen is missing: scripts/install-deps.sh installs it";
   for (const char* name : kClosedMeshes) {
@@ -102,8 +129,8 @@ TEST(Tetrahedralise, BuiltinVolumeErrorWithoutCorrectionShrinksAsTheCellSquared)
   const TriMesh surface = readSurface(kMeshes / "liver_coarse.obj");
   const double exact = enclosedVolume(surface);
   const double h = 20;  // mm
-  const double coarse = meshVolume(stuffIsosurface(surface, {h, false}));
-  const double fine = meshVolume(stuffIsosurface(surface, {h / 2, false}));
+  const double coarse = meshVolume(stuffIsosurface(surface, {h, false}).mesh);
+  const double fine = meshVolume(stuffIsosurface(surface, {h / 2, false}).mesh);
   const double errCoarse = (exact - coarse) / exact, errFine = (exact - fine) / exact;
   EXPECT_GT(errCoarse, 0);
   EXPECT_GT(errFine, 0);
@@ -115,7 +142,7 @@ TEST(Tetrahedralise, BuiltinBoundaryVerticesLieOnTheSurface) {
   // With no volume correction, every boundary vertex is a cut point or a warped lattice vertex:
   // on the surface, up to float rounding. Checked on a unit sphere of 320 faces.
   const TriMesh surface = readSurface(kMeshes / "sphere_coarse.obj");
-  const TetMesh mesh = stuffIsosurface(surface, {0.1, false});
+  const TetMesh mesh = stuffIsosurface(surface, {0.1, false}).mesh;
   std::set<Index> boundary;
   for (const Triangle& f : boundaryFaces(mesh)) boundary.insert(f.begin(), f.end());
   ASSERT_GT(boundary.size(), 100u);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "vrdeform/mesh/tet_mesh.h"
+#include "vrdeform/mesh/tet_pieces.h"
 
 namespace vrd {
 
@@ -39,7 +40,14 @@ struct Tetrahedralisation {
   double maxVolume = 0;   ///< the bound of the run that was kept (0: none)
   double radiusEdge = 0;  ///< TetGen's quality bound of that run (0: none)
   int runs = 0;           ///< mesher runs the count search took
+  /// Built-in mesher: fragments of parts thinner than about a lattice cell, dropped so that the
+  /// mesh is one face-connected piece per solid (Stuffing::dropped); droppedMessage() words it.
+  DroppedPieces dropped;
 };
+
+/// What a user is told of `result.dropped` ("" when nothing was dropped): how much went, why,
+/// and that more tets keep it.
+std::string droppedMessage(const Tetrahedralisation& result);
 
 /// Checks the surface (requireClosedSurface) and tetrahedralises it; every tet comes out
 /// positively oriented. Throws vrd::Error with the check's findings, for a TetGen that is

@@ -5,6 +5,7 @@
 // surface, so the mesh's volume follows the surface's while the tets keep bounded angles.
 
 #include "vrdeform/mesh/tet_mesh.h"
+#include "vrdeform/mesh/tet_pieces.h"
 
 namespace vrd {
 
@@ -18,9 +19,17 @@ struct StuffingOptions {
   std::size_t maxLatticeVertices = 50'000'000;
 };
 
+struct Stuffing {
+  TetMesh mesh;
+  /// A part of the solid thinner than about a cell can come out as fragments: loose, or joined to
+  /// the rest only along an edge or at a vertex. They are dropped (keepOnePiecePerShell), so the
+  /// mesh is one face-connected piece per solid, and counted here.
+  DroppedPieces dropped;
+};
+
 /// Tetrahedralises the solid inside a closed, consistently oriented surface (check it first with
 /// requireClosedSurface). All tets are positively oriented. Throws vrd::Error when the cell size
 /// is not positive or the lattice would exceed `maxLatticeVertices`.
-TetMesh stuffIsosurface(const TriMesh& surface, const StuffingOptions& options);
+Stuffing stuffIsosurface(const TriMesh& surface, const StuffingOptions& options);
 
 }  // namespace vrd
