@@ -23,8 +23,7 @@ struct UnionFind {
 // Labels 0..count-1 from union-find roots, in order of first appearance.
 std::size_t label(UnionFind& sets, std::vector<Index>& of) {
   std::unordered_map<Index, Index> number;
-  for (Index i = 0; i < of.size(); ++i)
-    of[i] = number.emplace(sets.find(i), Index(number.size())).first->second;
+  for (Index i = 0; i < of.size(); ++i) of[i] = number.emplace(sets.find(i), Index(number.size())).first->second;
   return number.size();
 }
 
@@ -60,8 +59,8 @@ DroppedPieces keepOnePiecePerShell(TetMesh& mesh, const TriMesh& surface) {
   std::vector<double> volume(pieces.count, 0.0);
   for (Index t = 0; t < mesh.tets.size(); ++t) {
     const Tet& tet = mesh.tets[t];
-    volume[pieces.of[t]] += std::abs(double(signedTetVolume(mesh.vertices[tet[0]], mesh.vertices[tet[1]],
-                                                            mesh.vertices[tet[2]], mesh.vertices[tet[3]])));
+    volume[pieces.of[t]] += std::abs(double(
+        signedTetVolume(mesh.vertices[tet[0]], mesh.vertices[tet[1]], mesh.vertices[tet[2]], mesh.vertices[tet[3]])));
   }
 
   // The surface's shells, and each piece's: the shell nearest most of its vertices.

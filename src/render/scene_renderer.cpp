@@ -31,7 +31,8 @@ void main() {
 }
 )";
 
-// uMode: 0 plain colour, 1 colour map (blue - white - red over [-uRange, uRange]), 2 checkered ground.
+// uMode: 0 plain colour, 1 colour map (blue - white - red over [-uRange, uRange]), 2 checkered ground,
+// 3 a shadow on that ground (its checker, darkened; opaque, so overlapping triangles draw it once).
 constexpr const char* kFragmentShader = R"(#version 330 core
 in vec3 vPosition;
 in vec3 vNormal;
@@ -52,9 +53,13 @@ void main() {
     float t = clamp(vValue / uRange, -1.0, 1.0);
     vec3 mid = vec3(0.92);
     base = t < 0.0 ? mix(mid, vec3(0.15, 0.35, 0.95), -t) : mix(mid, vec3(0.9, 0.15, 0.1), t);
-  } else if (uMode == 2) {
+  } else if (uMode >= 2) {
     vec3 cell = floor(vPosition / uCell);
     base = mod(cell.x + cell.y + cell.z, 2.0) < 1.0 ? uColor : uColor * 0.8;
+    if (uMode == 3) {
+      fragColor = vec4(0.42 * base, 1.0);  // about the ambient share of the lit ground
+      return;
+    }
   }
   float diffuse = max(dot(n, uLight), 0.0);
   float specular = pow(max(dot(n, normalize(uLight + toEye)), 0.0), 40.0);
@@ -244,6 +249,24 @@ void SceneRenderer::draw(const PosedScene& scene, const Snapshot& snapshot, cons
       gl_->sphere->draw();
     }
 
+  // The bodies' and fingertips' shadows on a ground plane {x : n.x = offset}: flattened onto it
+  // along a fixed light from above (so they fall under what casts them, grounding it), lifted by
+  // `lift` above the plane's square.
+  const auto drawShadows = [&](const Vec3& n, float offset, const Vec3& across, float lift) {
+    const Vec3 light = (n + 0.25f * n.cross(across) + 0.15f * across).normalized();
+    const Mat3 flatten = Mat3::Identity() - light * n.transpose() / n.dot(light);
+    const Vec3 shift = light * (offset / n.dot(light)) + lift * n;
+    p.set("uMode", 3);
+    place(flatten, shift);
+    for (std::size_t i = 0; i < scene.meshCount(); ++i) gl_->meshes[i]->draw();
+    if (settings.fingertips && snapshot.fingertipRadius > 0.0f)
+      for (int f = 0; f < kFingerCount; ++f)
+        if (snapshot.fingerPresent[f] && settings.showFinger[f]) {
+          place(flatten * snapshot.fingertipRadius, flatten * snapshot.fingertips[f] + shift);
+          gl_->sphere->draw();
+        }
+  };
+
   // Colliders; planes become a checkered square around the bodies.
   if (settings.colliders) {
     const Eigen::AlignedBox3f& box = scene.bounds();
@@ -261,6 +284,7 @@ void SceneRenderer::draw(const PosedScene& scene, const Snapshot& snapshot, cons
         p.set("uCell", 0.25f * extent);
         place(basis * (8.0f * extent), onPlane);
         gl_->square->draw();
+        drawShadows(n, n.dot(c.center), a, 1e-3f * extent);
         p.set("uMode", 0);
       } else if (c.shape == ColliderShape::Sphere) {
         place(c.radius * Mat3::Identity(), c.center);

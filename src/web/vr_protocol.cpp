@@ -209,6 +209,9 @@ std::vector<std::uint8_t> encodeBodyBlock(std::uint32_t body, std::span<const Ve
     box.scale = (hi - lo + 2.0f * margin) / 65535.0f;
     box.valid = true;
   }
+  // The values last sent count only in the same box, for as many positions.
+  const bool fresh = !inside || box.sent.size() != 3 * positions.size();
+  if (fresh) box.sent.assign(3 * positions.size(), 0);
   const std::size_t data = 6 * positions.size();
   std::vector<std::uint8_t> out(frame::kBlockHeaderBytes + (data + 3) / 4 * 4, 0);
   std::uint8_t* p = out.data();
@@ -220,10 +223,13 @@ std::vector<std::uint8_t> encodeBodyBlock(std::uint32_t body, std::span<const Ve
   }
   p += frame::kBlockHeaderBytes;
   const Vec3 inv = box.scale.cwiseInverse();
+  std::uint16_t* sent = box.sent.data();
   for (const Vec3& x : positions)
-    for (int k = 0; k < 3; ++k, p += 2) {
+    for (int k = 0; k < 3; ++k, p += 2, ++sent) {
       const float q = std::isfinite(x[k]) ? std::round((x[k] - box.origin[k]) * inv[k]) : 0.0f;
-      put(p, std::uint16_t(std::clamp(q, 0.0f, 65535.0f)));
+      const auto value = std::uint16_t(std::clamp(q, 0.0f, 65535.0f));
+      if (fresh || std::abs(int(value) - int(*sent)) > 1) *sent = value;
+      put(p, *sent);
     }
   return out;
 }

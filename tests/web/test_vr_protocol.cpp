@@ -55,13 +55,20 @@ TEST(VrProtocol, BodyBlocksRoundTripWithinAQuantumAndStayIdenticalAtRest) {
   // Bounds 0.2 m wide grown by half on each side: a quantum of 0.4 m / 65535, about 6 um.
   EXPECT_LT(box.scale.maxCoeff(), 1e-5f);
 
-  // The same positions give the same bytes (so a body at rest is left out of frames); a move
+  // The same positions give the same bytes (so a body at rest is left out of frames), and so do
+  // positions jittered by less than a quantum, as float rounding jitters a body at rest; a move
   // inside the box keeps the box; one outside refits it.
   EXPECT_EQ(vr::encodeBodyBlock(7, x, box), block);
+  std::vector<Vec3> jittered = x;
+  for (std::size_t i = 0; i < x.size(); ++i) jittered[i] += (i % 2 ? 0.6f : -0.6f) * box.scale;
+  EXPECT_EQ(vr::encodeBodyBlock(7, jittered, box), block);
   const vr::QuantBox before = box;
   x[3].y() += 0.01f;
-  vr::encodeBodyBlock(7, x, box);
+  const std::vector<Vec3> z = decodeBlock(vr::encodeBodyBlock(7, x, box));
   EXPECT_EQ(box.origin, before.origin);
+  EXPECT_NEAR(z[3].y(), x[3].y(), 0.5f * box.scale.y() + 1e-7f);  // a real move is sent
+  for (std::size_t i = 0; i < x.size(); ++i)
+    EXPECT_LE((z[i] - x[i]).cwiseAbs().maxCoeff(), 1.5f * box.scale.maxCoeff() + 1e-7f) << i;
   x[3].y() += 1.0f;
   const auto moved = vr::encodeBodyBlock(7, x, box);
   EXPECT_NE(box.origin, before.origin);

@@ -67,17 +67,21 @@ std::array<std::uint8_t, frame::kHeaderBytes> encodeFrameHeader(const Snapshot& 
                                                                 std::uint32_t flags);
 void setBlockCount(std::span<std::uint8_t, frame::kHeaderBytes> header, std::uint32_t blocks);
 
-/// The box positions are quantised in. It is kept while the body stays inside it, so a body at
-/// rest quantises to the same bytes frame after frame and is left out of the frames.
+/// The box positions are quantised in, and the values last sent. The box is kept while the body
+/// stays inside it, and a value is resent only once it moves by more than one quantum, so a body
+/// at rest (float rounding jitters it far below a quantum) encodes to the same bytes frame after
+/// frame and is left out of the frames.
 struct QuantBox {
   Vec3 origin = Vec3::Zero();
   Vec3 scale = Vec3::Zero();  ///< metres per unit; (extent of the box) / 65535
   bool valid = false;
+  std::vector<std::uint16_t> sent;  ///< the last block's values, 3 per position (empty: none yet)
 };
 
 /// A body block of `positions` (quantised in `box`, which is refitted first when a position lies
-/// outside it: the body's bounds grown by half their size, at least 1 cm, on every side).
-/// Non-finite positions quantise to the box's origin. Returns the block's bytes.
+/// outside it: the body's bounds grown by half their size, at least 1 cm, on every side): within
+/// half a quantum, or within one and a half where the value last sent is kept. Non-finite
+/// positions quantise to the box's origin. Returns the block's bytes.
 std::vector<std::uint8_t> encodeBodyBlock(std::uint32_t body, std::span<const Vec3> positions, QuantBox& box);
 
 /// What a page sends (docs/vr.md#client-messages).
