@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -87,12 +88,20 @@ HapticCalibration calibrateHaptics(const World& original, BodyId body, const Hap
         body, 1e3f * sag, 1e3f * depth));
 
   const std::size_t count = world.fingertipContactCount(tip);
-  if (count == 0)
-    throw Error(fmt::format("calibration: the poke made no contact with body {}{}", body,
-                            settings.friction.staticFriction > 0.0f
-                                ? ""
-                                : " (a frictionless fingertip can push a round body out from under it: give the "
-                                  "hand friction)"));
+  if (count == 0) {
+    float speed = 0.0f;
+    for (Index i = world.body(body).firstParticle; i < world.body(body).firstParticle + world.body(body).particleCount;
+         ++i)
+      speed = std::max(speed, world.particles().v[i].norm());
+    throw Error(fmt::format(
+        "calibration: the poke made no contact with body {}{}", body,
+        speed > 0.05f ? fmt::format(": the body is still moving (up to {:.3g} m/s), so it left the point poked; let it "
+                                    "come to rest first, or check its size (a mesh in millimetres needs scale = 0.001)",
+                                    speed)
+        : settings.friction.staticFriction > 0.0f
+            ? ""
+            : " (a frictionless fingertip can push a round body out from under it: give the hand friction)"));
+  }
   HapticCalibration out;
   out.signal = base;
   out.point = point;

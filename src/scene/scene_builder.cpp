@@ -290,7 +290,10 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneBuildObserver& observer)
     try {
       scene.calibration = calibrateHaptics(world, body->id, scene.session.haptics.signal, c);
     } catch (const Error& e) {
-      throw Error(fmt::format("calibrating the haptics on body '{}': {}", body->name, e.what()));
+      throw Error(fmt::format(
+          "calibrating the haptics on body '{}': {} ([haptics] calibrate = false, or touch --no-calibrate, keeps the "
+          "default scales)",
+          body->name, e.what()));
     }
     scene.session.haptics.signal = scene.calibration->signal;
     say(log, fmt::format("haptics calibrated on '{}': a standard poke {:.1f} mm deep gave {:.4f} N over {} contacts",
