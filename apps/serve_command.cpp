@@ -25,7 +25,8 @@ namespace vrd {
 namespace {
 
 struct ServeArgs {
-  std::string scene, bind = "127.0.0.1", weart;
+  std::string scene, bind = "127.0.0.1", weart, tlsFolder;
+  bool tls = false;
   std::uint16_t port = 8080;
   double frameRate = 72.0;
   double seconds = 0.0;  // 0: until Ctrl-C
@@ -50,13 +51,16 @@ std::vector<std::string> lanAddresses() {
 void printAddresses(const ServeArgs& a, std::uint16_t port) {
   const bool everywhere = a.bind == "0.0.0.0" || a.bind == "::";
   const std::string local = everywhere || a.bind == "127.0.0.1" ? "127.0.0.1" : a.bind;
-  fmt::print("serving on http://{}:{}/ (Ctrl-C stops)\n", local, port);
+  const char* scheme = a.tls ? "https" : "http";
+  fmt::print("serving on {}://{}:{}/ (Ctrl-C stops)\n", scheme, local, port);
   if (local == "127.0.0.1")
-    fmt::print("  a Quest over USB: adb reverse tcp:{0} tcp:{0}, then open http://localhost:{0}/ in its browser\n",
-               port);
+    fmt::print("  a Quest over USB: adb reverse tcp:{0} tcp:{0}, then open {1}://localhost:{0}/ in its browser\n", port,
+               scheme);
   if (everywhere)
     for (const std::string& ip : lanAddresses())
-      fmt::print("  on the local network: http://{}:{}/ (not a secure context: see docs/vr.md for WebXR)\n", ip, port);
+      fmt::print("  on the local network: {}://{}:{}/{}\n", scheme, ip, port,
+                 a.tls ? " (accept the certificate once: its fingerprint is above)"
+                       : " (not a secure context, so no WebXR: --tls, or see docs/vr.md)");
   std::fflush(stdout);
 }
 
@@ -77,6 +81,15 @@ int serve(const ServeArgs& a) {
   vs.bind = a.bind;
   vs.port = a.port;
   vs.frameRate = a.frameRate;
+  if (a.tls) {
+    const std::filesystem::path folder = a.tlsFolder.empty() ? defaultTlsFolder() : std::filesystem::path(a.tlsFolder);
+    vs.tls = loadOrCreateTlsIdentity(folder, lanAddresses());
+    fmt::print(
+        "tls: {} certificate {}/cert.pem\n  SHA-256 fingerprint {}\n  Chromium: "
+        "--ignore-certificate-errors-spki-list={}\n",
+        vs.tls->created ? "made a self-signed" : "the self-signed", folder.string(), vs.tls->fingerprint,
+        vs.tls->spkiHash);
+  }
   vs.hand.park = scene.bodies.front().top + Vec3(0.0f, 0.15f, 0.0f);
   const float radius = scene.session.hand.geometry.fingertipRadius;
   std::optional<LiveHandInput> hand;
@@ -140,6 +153,11 @@ std::function<int()> addServeCommand(CLI::App& app) {
       ->add_option("--bind", a->bind,
                    "Address to listen on; 0.0.0.0 serves the local network (prints the addresses to open)")
       ->capture_default_str();
+  serve->add_flag("--tls", a->tls,
+                  "Serve HTTPS and WSS (WebXR on the local network needs them) with a self-signed certificate, made "
+                  "on first use (its fingerprint printed)");
+  serve->add_option("--tls-dir", a->tlsFolder,
+                    "Where the certificate and key are kept (default: ~/.config/vrdeform/tls)");
   serve->add_option("--fps", a->frameRate, "Frames per second sent to the viewers at most")
       ->check(CLI::Range(1.0, 1000.0))
       ->capture_default_str();

@@ -20,6 +20,7 @@ packages=(
   clang-format        # code style check
   clang libclang-rt-14-dev lld   # libFuzzer for the fuzz targets (fuzz/); lld drops their unused code
   libboost1.81-dev    # Boost.Beast (HTTP, WebSocket) for the VR server (vrdeform serve)
+  libssl-dev          # OpenSSL: serve --tls (HTTPS, WSS, its self-signed certificate)
   chromium            # the VR page's browser test (headless, with an emulated headset)
   libepoxy-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri   # OpenGL renderer; headless on Mesa's EGL surfaceless
   libglfw3-dev libimgui-dev libstb-dev   # desktop viewer window and panels; PNG frames

@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "tls_front.h"
 #include "vrdeform/error.h"
 #include "vrdeform/web/static_files.h"
 #include "vrdeform/web/vr_protocol.h"
@@ -137,6 +138,7 @@ struct Server {
 
   std::optional<net::io_context> ioc;
   std::optional<tcp::acceptor> acceptor;
+  std::optional<TlsFront> tls;  // with settings.tls: the public port, tunnelling to acceptor's
   std::optional<net::steady_timer> timer;
   std::thread thread;
   std::atomic<bool> ioDone{false};
@@ -689,6 +691,7 @@ void Server::shutdown() {
   shuttingDown = true;
   beast::error_code ec;
   acceptor->close(ec);
+  if (tls) tls->stop();
   timer->cancel();
   for (const std::weak_ptr<Viewer>& w : viewers)
     if (const auto v = w.lock()) v->close(websocket::close_code::going_away, "the server is stopping");
@@ -730,13 +733,20 @@ void VrServer::start() {
   const net::ip::address address = net::ip::make_address(s.settings.bind, ec);
   if (ec) throw Error(fmt::format("--bind {}: not an IP address", s.settings.bind));
   s.acceptor.emplace(*s.ioc);
-  const tcp::endpoint endpoint(address, s.settings.port);
+  // With TLS the plain server listens on a loopback port of its own, behind the TLS front.
+  const tcp::endpoint endpoint =
+      s.settings.tls ? tcp::endpoint(net::ip::address_v4::loopback(), 0) : tcp::endpoint(address, s.settings.port);
   s.acceptor->open(endpoint.protocol(), ec);
   if (!ec) s.acceptor->set_option(net::socket_base::reuse_address(true), ec);
   if (!ec) s.acceptor->bind(endpoint, ec);
   if (!ec) s.acceptor->listen(net::socket_base::max_listen_connections, ec);
   if (ec) throw Error(fmt::format("cannot listen on {}:{}: {}", s.settings.bind, s.settings.port, ec.message()));
   s.port.store(s.acceptor->local_endpoint().port());
+  if (s.settings.tls) {
+    s.tls.emplace(*s.ioc, *s.settings.tls, [&s](std::string_view line) { s.logLimited(std::string(line)); });
+    s.tls->start(tcp::endpoint(address, s.settings.port), s.acceptor->local_endpoint());
+    s.port.store(s.tls->port());
+  }
   s.timer.emplace(*s.ioc);
   s.nextTick = Clock::now();
   acceptNext(s);
@@ -754,6 +764,7 @@ void VrServer::stop() {
   s.ioc->stop();
   s.thread.join();
   s.timer.reset();
+  s.tls.reset();
   s.acceptor.reset();
   s.ioc.reset();  // destroys the handlers still pending, and with them the sessions
   s.viewers.clear();

@@ -1,6 +1,7 @@
 // The VR server over loopback (web/vr_server.h), with a plain WebSocket and HTTP client (Beast):
 // the scene and topology then frames, viewers' input driving the hand, hostile input rejected
-// without stalling the simulation, and a slow viewer skipping frames in bounded memory.
+// without stalling the simulation, and a slow viewer skipping frames in bounded memory; and over
+// TLS with its self-signed certificate (web/tls_identity.h), checked by the client.
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -11,13 +12,18 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <boost/asio/connect.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/ssl.hpp>
 #include <boost/asio/write.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
+#include <boost/beast/ssl.hpp>
 #include <boost/beast/websocket.hpp>
+#include <boost/beast/websocket/ssl.hpp>
 #pragma GCC diagnostic pop
 #include <chrono>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -27,6 +33,7 @@
 #include "test_support.h"
 #include "vrdeform/scene/scene_library.h"
 #include "vrdeform/web/static_files.h"
+#include "vrdeform/web/tls_identity.h"
 #include "vrdeform/web/vr_protocol.h"
 #include "vrdeform/web/vr_server.h"
 
@@ -391,6 +398,100 @@ TEST(VrServer, ASlowViewerSkipsFramesInBoundedMemoryWhileOthersKeepUp) {
   testing::record("frame_bytes", double(frame.size()));
   testing::record("topology_bytes", double(topology.size()));
   testing::record("frames_skipped", double(s.server->stats().framesSkipped));
+}
+
+// --- TLS -----------------------------------------------------------------------------------------
+
+namespace ssl = net::ssl;
+
+// A client context that trusts only `identity`'s certificate and checks that it names 127.0.0.1.
+ssl::context trusting(const TlsIdentity& identity) {
+  ssl::context c(ssl::context::tls_client);
+  c.add_certificate_authority(net::buffer(identity.certificatePem));
+  c.set_verify_mode(ssl::verify_peer);
+  return c;
+}
+
+TEST(TlsIdentity, MadeOnceKeptPrivateAndReadBack) {
+  const testing::TempDir dir;
+  const TlsIdentity made = loadOrCreateTlsIdentity(dir / "tls", {"192.0.2.7"});
+  EXPECT_TRUE(made.created);
+  EXPECT_EQ(made.fingerprint.size(), 32u * 3 - 1);  // SHA-256 as AB:CD:...
+  EXPECT_EQ(made.spkiHash.size(), 44u);             // base64 of 32 bytes
+  namespace fs = std::filesystem;
+  EXPECT_EQ(fs::status(dir / "tls" / "key.pem").permissions() & (fs::perms::group_all | fs::perms::others_all),
+            fs::perms::none);
+  const TlsIdentity read = loadOrCreateTlsIdentity(dir / "tls", {});
+  EXPECT_FALSE(read.created);
+  EXPECT_EQ(read.fingerprint, made.fingerprint);
+  EXPECT_EQ(read.spkiHash, made.spkiHash);
+  EXPECT_EQ(read.certificatePem, made.certificatePem);
+
+  // A folder with half a pair, a pair that does not match, garbage: clear errors, nothing made.
+  const TlsIdentity other = loadOrCreateTlsIdentity(dir / "other", {});
+  EXPECT_NE(other.fingerprint, made.fingerprint);
+  fs::create_directories(dir / "half");
+  fs::copy_file(dir / "tls" / "cert.pem", dir / "half" / "cert.pem");
+  EXPECT_NE(testing::errorOf([&] { loadOrCreateTlsIdentity(dir / "half", {}); }).find("has cert.pem but not key.pem"),
+            std::string::npos);
+  fs::copy_file(dir / "other" / "key.pem", dir / "half" / "key.pem");
+  EXPECT_NE(testing::errorOf([&] { loadOrCreateTlsIdentity(dir / "half", {}); }).find("do not belong together"),
+            std::string::npos);
+  std::ofstream(dir / "half" / "cert.pem") << "garbage";
+  EXPECT_NE(testing::errorOf([&] { loadOrCreateTlsIdentity(dir / "half", {}); }).find("not a PEM certificate"),
+            std::string::npos);
+}
+
+TEST(VrServer, TlsServesThePageAndTheWebSocketWithItsCertificate) {
+  const testing::TempDir dir;
+  VrServerSettings settings;
+  settings.tls = loadOrCreateTlsIdentity(dir / "tls", {});
+  Served s(settings);
+  const tcp::endpoint at(net::ip::make_address("127.0.0.1"), s.server->port());
+  net::io_context ioc;
+  ssl::context context = trusting(*settings.tls);
+
+  // HTTPS: the page, over a connection whose certificate the client checked (name and chain).
+  const auto page = [&] {
+    beast::ssl_stream<beast::tcp_stream> https(ioc, context);
+    https.set_verify_callback(ssl::host_name_verification("127.0.0.1"));
+    beast::get_lowest_layer(https).connect(at);
+    https.handshake(ssl::stream_base::client);
+    http::request<http::empty_body> req{http::verb::get, "/", 11};
+    req.set(http::field::host, "127.0.0.1");
+    http::write(https, req);
+    beast::flat_buffer b;
+    http::response<http::string_body> res;
+    http::read(https, b, res);
+    return res;
+  };
+  const auto res = page();
+  EXPECT_EQ(res.result(), http::status::ok);
+  EXPECT_NE(res.body().find("importmap"), std::string::npos);
+
+  // WSS: the scene, then its topology.
+  websocket::stream<beast::ssl_stream<beast::tcp_stream>> wss(ioc, context);
+  beast::get_lowest_layer(wss).connect(at);
+  wss.next_layer().handshake(ssl::stream_base::client);
+  wss.read_message_max(64 << 20);
+  wss.handshake("127.0.0.1", "/ws");
+  beast::flat_buffer b;
+  wss.read(b);
+  EXPECT_TRUE(wss.got_text());
+  EXPECT_EQ(json::parse(beast::buffers_to_string(b.data()))["type"], "scene");
+
+  // Plain HTTP at the TLS port gets no page, and the server goes on serving.
+  const std::string plain = get(s.server->port(), "/");
+  EXPECT_EQ(plain.find("HTTP/1.1 200"), std::string::npos) << plain.substr(0, 100);
+  EXPECT_EQ(page().result(), http::status::ok);
+  // A client that trusts another certificate refuses this server's.
+  const TlsIdentity stranger = loadOrCreateTlsIdentity(dir / "stranger", {});
+  ssl::context wrong = trusting(stranger);
+  beast::ssl_stream<beast::tcp_stream> refused(ioc, wrong);
+  beast::get_lowest_layer(refused).connect(at);
+  beast::error_code ec;
+  refused.handshake(ssl::stream_base::client, ec);
+  EXPECT_TRUE(ec) << "the handshake succeeded with an untrusted certificate";
 }
 
 }  // namespace

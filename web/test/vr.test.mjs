@@ -39,15 +39,15 @@ async function until(what, check, timeoutMs = 10000) {
   throw new Error(`timed out after ${timeoutMs} ms waiting for ${what}`);
 }
 
-function startServer() {
-  const server = spawn(vrdeform, ['serve', 'liver', '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
+function startServer(extra = []) {
+  const server = spawn(vrdeform, ['serve', 'liver', '--port', '0', ...extra], { stdio: ['ignore', 'pipe', 'pipe'] });
   let output = '';
   const exited = new Promise((resolve) => server.on('exit', (code, signal) => resolve({ code, signal })));
   const url = new Promise((resolve, reject) => {
     const timer = setTimeout(() => reject(new Error(`vrdeform serve did not start in 90 s:\n${output}`)), 90000);
     server.stdout.on('data', (chunk) => {
       output += chunk;
-      const m = output.match(/serving on (http:\/\/127\.0\.0\.1:\d+\/)/);
+      const m = output.match(/serving on (https?:\/\/127\.0\.0\.1:\d+\/)/);
       if (m) {
         clearTimeout(timer);
         resolve(m[1]);
@@ -62,6 +62,41 @@ function startServer() {
   return { server, url, exited, output: () => output };
 }
 
+// Headless Chromium with WebGL in software; `args` adds flags.
+function openHeadset(profile, args = []) {
+  return chromium.launchPersistentContext(profile, {
+    executablePath: chromiumPath,
+    headless: true,
+    viewport: { width: 800, height: 450 },
+    args: [
+      '--no-sandbox',
+      '--disable-gpu',
+      '--disable-background-networking',
+      '--disable-dev-shm-usage',
+      '--use-angle=swiftshader',
+      '--enable-unsafe-swiftshader',
+      ...args,
+    ],
+  });
+}
+
+// A page with the emulated Quest 3 (stereo, looking down at the table) installed before any of
+// its scripts, and its errors collected.
+async function headsetPage(context) {
+  const page = context.pages()[0] || (await context.newPage());
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  page.on('console', (m) => m.type() === 'error' && errors.push(m.text()));
+  await page.addInitScript({ path: iwerScript });
+  await page.addInitScript(() => {
+    const device = new IWER.XRDevice(IWER.metaQuest3, { stereoEnabled: true });
+    device.installRuntime({ forceInstall: true });
+    device.quaternion.set(-Math.sin(Math.PI / 12), 0, 0, Math.cos(Math.PI / 12)); // 30 degrees down
+    window.__xrDevice = device;
+  });
+  return { page, errors };
+}
+
 test('the VR page in an emulated headset: both eyes, mesh frames, poke and grasp', { timeout: 150000 }, async (t) => {
   const { server, url, exited, output } = startServer();
   const profile = mkdtempSync(path.join(tmpdir(), 'vrdeform-chromium-'));
@@ -74,32 +109,9 @@ test('the VR page in an emulated headset: both eyes, mesh frames, poke and grasp
   const base = await url;
   const status = async () => (await fetch(`${base}status.json`)).json();
 
-  const context = await chromium.launchPersistentContext(profile, {
-    executablePath: chromiumPath,
-    headless: true,
-    viewport: { width: 800, height: 450 },
-    args: [
-      '--no-sandbox',
-      '--disable-gpu',
-      '--disable-background-networking',
-      '--disable-dev-shm-usage',
-      '--use-angle=swiftshader',
-      '--enable-unsafe-swiftshader',
-    ],
-  });
+  const context = await openHeadset(profile);
   browser = context;
-  const page = context.pages()[0] || (await context.newPage());
-  const errors = [];
-  page.on('pageerror', (e) => errors.push(String(e)));
-  page.on('console', (m) => m.type() === 'error' && errors.push(m.text()));
-  // The emulated Quest 3, stereo, looking down at the table; before any of the page's scripts.
-  await page.addInitScript({ path: iwerScript });
-  await page.addInitScript(() => {
-    const device = new IWER.XRDevice(IWER.metaQuest3, { stereoEnabled: true });
-    device.installRuntime({ forceInstall: true });
-    device.quaternion.set(-Math.sin(Math.PI / 12), 0, 0, Math.cos(Math.PI / 12)); // 30 degrees down
-    window.__xrDevice = device;
-  });
+  const { page, errors } = await headsetPage(context);
   await page.goto(base);
   await until('the scene and mesh frames', () => page.evaluate(() => vrdeform.state.framesReceived > 3), 30000);
   const scene = await page.evaluate(() => vrdeform.state.scene);
@@ -196,6 +208,40 @@ test('the VR page in an emulated headset: both eyes, mesh frames, poke and grasp
 
   // The server stops cleanly on SIGTERM.
   await context.close();
+  browser = null;
+  server.kill('SIGTERM');
+  const { code } = await exited;
+  assert.equal(code, 0, output());
+});
+
+// `serve --tls`: HTTPS and WSS with the self-signed certificate it made, which Chromium is told to
+// trust by the public-key hash the server printed (as a headset's user accepts it once): a secure
+// context, the scene over WSS and an immersive-vr session.
+test('the VR page over TLS: a secure context, the scene over WSS, immersive VR', { timeout: 150000 }, async (t) => {
+  const certs = mkdtempSync(path.join(tmpdir(), 'vrdeform-tls-'));
+  const { server, url, exited, output } = startServer(['--tls', '--tls-dir', certs]);
+  const profile = mkdtempSync(path.join(tmpdir(), 'vrdeform-chromium-'));
+  let browser;
+  t.after(async () => {
+    if (browser) await browser.close().catch(() => {});
+    if (server.exitCode === null) server.kill('SIGKILL');
+    rmSync(profile, { recursive: true, force: true });
+    rmSync(certs, { recursive: true, force: true });
+  });
+  const base = await url;
+  assert.match(base, /^https:/);
+  const spki = output().match(/--ignore-certificate-errors-spki-list=(\S+)/);
+  assert.ok(spki, `no public-key hash printed:\n${output()}`);
+  browser = await openHeadset(profile, [`--ignore-certificate-errors-spki-list=${spki[1]}`]);
+  const { page, errors } = await headsetPage(browser);
+  await page.goto(base);
+  assert.equal(await page.evaluate(() => window.isSecureContext), true);
+  await until('the scene and mesh frames over WSS', () => page.evaluate(() => vrdeform.state.framesReceived > 3), 30000);
+  assert.equal(await page.evaluate(() => vrdeform.state.scene.name), 'liver');
+  await page.click('#VRButton');
+  await until('an immersive-vr session', () => page.evaluate(() => vrdeform.state.xrPresenting && vrdeform.state.xrFrames > 10));
+  assert.deepEqual(errors, [], `page errors: ${errors.join('\n')}`);
+  await browser.close();
   browser = null;
   server.kill('SIGTERM');
   const { code } = await exited;

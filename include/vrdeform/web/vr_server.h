@@ -1,7 +1,7 @@
 #pragma once
 // The VR server (`vrdeform serve`): one port serves the page (static files), a status document
-// and a WebSocket. Every viewer gets the scene and its topology once, then a frame per new
-// snapshot at display rate; a viewer's controller or tracked hand drives the simulation's hand.
+// and a WebSocket, over TLS when given a certificate. Every viewer gets the scene and its topology once, then a frame
+// per new snapshot at display rate; a viewer's controller or tracked hand drives the simulation's hand.
 //
 // One I/O thread does all of the networking and reads the loop's snapshots through its own
 // channel; the loop never waits for it, nor it for a viewer. Each viewer has at most one frame in
@@ -19,6 +19,7 @@
 
 #include "vrdeform/interact/live_hand_input.h"
 #include "vrdeform/scene/simulation_loop.h"
+#include "vrdeform/web/tls_identity.h"
 #include "vrdeform/web/xr_hand.h"
 
 namespace vrd {
@@ -39,6 +40,8 @@ struct VrServerSettings {
   std::function<std::optional<float>()> gloveClosure;
   /// Whether a glove receives the forces (pages then leave their controllers' vibration off).
   std::function<bool()> gloveConnected;
+  /// Serve HTTPS and WSS with this certificate instead of HTTP and WS (tls_identity.h).
+  std::optional<TlsIdentity> tls;
   /// Where log lines go (connections, rejected input); default: stderr.
   std::function<void(std::string_view)> log;
 };
