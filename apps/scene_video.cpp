@@ -34,14 +34,18 @@ void addVideoOptions(CLI::App& command, VideoOptions& options) {
           },
           "Frame size in pixels, WIDTHxHEIGHT (default 640x480)")
       ->type_name("WxH");
+  addColorMapOption(command, options.colorMap);
+}
+
+void addColorMapOption(CLI::App& command, ColorMap& colorMap) {
   command
       .add_option_function<std::string>(
           "--color-map",
-          [&options](const std::string& s) {
+          [&colorMap](const std::string& s) {
             const std::optional<ColorMap> map = parseColorMap(s);
             if (!map)
               throw CLI::ValidationError("--color-map", "expected none, strain, volume or force, got '" + s + "'");
-            options.colorMap = *map;
+            colorMap = *map;
           },
           "Colour the bodies by: none, strain (edge stretch), volume (volume change) or force (each particle's "
           "constraint force, N)")

@@ -23,6 +23,8 @@ struct VideoOptions {
 
 /// Adds --fps, --size WxH and --color-map to a command.
 void addVideoOptions(CLI::App& command, VideoOptions& options);
+/// Adds --color-map alone.
+void addColorMapOption(CLI::App& command, ColorMap& colorMap);
 
 class SceneVideo {
  public:

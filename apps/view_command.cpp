@@ -2,6 +2,7 @@
 
 #include <memory>
 
+#include "scene_video.h"
 #include "viewer/viewer.h"
 #include "vrdeform/devices/glove_link.h"
 
@@ -21,6 +22,7 @@ std::function<int()> addViewCommand(CLI::App& app) {
                   "Drive the hand from a WEART glove and send it the forces: HOST[:PORT] of the middleware (default "
                   "port 13031)")
       ->check(CLI::Validator(weartEndpointError, "HOST[:PORT]"));
+  addColorMapOption(*cmd, o->colorMap);
   cmd->add_option("--width", o->width, "Window width in pixels")->check(CLI::Range(320, 8192))->capture_default_str();
   cmd->add_option("--height", o->height, "Window height in pixels")
       ->check(CLI::Range(240, 8192))

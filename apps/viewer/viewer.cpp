@@ -119,6 +119,7 @@ class Viewer {
   void handleInput(float dt);
   void panels();
   void scenePanel();
+  void colorLegend() const;
   void solverPanel();
   void materialPanel();
   void hapticsPanel();
@@ -281,11 +282,35 @@ void Viewer::scenePanel() {
   }
   if (render_.colorMap == ColorMap::ConstraintForce)
     ImGui::SliderFloat("range (N)", &render_.colorRange, 0.001f, 100.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
-  else
+  else if (render_.colorMap != ColorMap::None)
     ImGui::SliderFloat("range", &render_.colorRange, 0.001f, 0.5f, "%.3f", ImGuiSliderFlags_Logarithmic);
+  if (render_.colorMap != ColorMap::None) colorLegend();
   ImGui::Checkbox("fingertips", &render_.fingertips);
   ImGui::SameLine();
   ImGui::Checkbox("colliders", &render_.colliders);
+}
+
+// The colour map's key: the bar the shader draws (blue at -range, white at 0, red at +range) with
+// its ends and middle labelled in the map's units.
+void Viewer::colorLegend() const {
+  const float r = render_.colorRange;
+  const bool force = render_.colorMap == ColorMap::ConstraintForce;
+  const std::string unit = force ? " N" : render_.colorMap == ColorMap::Strain ? " strain" : " of volume";
+  const ImVec2 at = ImGui::GetCursorScreenPos();
+  const float width = std::max(ImGui::GetContentRegionAvail().x, 60.0f), height = 12.0f;
+  const ImU32 blue = IM_COL32(38, 89, 242, 255), white = IM_COL32(235, 235, 235, 255), red = IM_COL32(230, 38, 26, 255);
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  const ImVec2 mid(at.x + 0.5f * width, at.y + height), end(at.x + width, at.y + height);
+  draw->AddRectFilledMultiColor(at, mid, blue, white, white, blue);
+  draw->AddRectFilledMultiColor(ImVec2(mid.x, at.y), end, white, red, red, white);
+  ImGui::Dummy(ImVec2(width, height));
+  // A force map shows magnitudes (0 to range, white to red); strain and volume change are signed.
+  const std::string low = force ? "" : fmt::format("{:.3g}{}", -r, unit), high = fmt::format("{:.3g}{}", r, unit);
+  ImGui::TextUnformatted(low.c_str());
+  ImGui::SameLine(0.5f * width - 0.5f * ImGui::CalcTextSize("0").x);
+  ImGui::TextUnformatted("0");
+  ImGui::SameLine(width - ImGui::CalcTextSize(high.c_str()).x);
+  ImGui::TextUnformatted(high.c_str());
 }
 
 void Viewer::solverPanel() {
@@ -352,10 +377,11 @@ void Viewer::forcePanel() {
               s.haptics.paper);
   for (int f = 0; f < kFingerCount; ++f) {
     if (!s.fingerPresent[f]) continue;
-    const std::string label = fmt::format("{} {:.2f} ({:.3f} N)", fingerName(Finger(f)), s.haptics.fingers[f].force,
-                                          s.haptics.fingers[f].newtons);
-    ImGui::PlotLines(label.c_str(), force_[f].data(), force_[f].size(), force_[f].offset(), nullptr, 0.0f, 1.0f,
-                     ImVec2(0, 40));
+    // The label above its plot, which takes the panel's width: beside it, it was cut off.
+    ImGui::Text("%s %.2f (%.3f N)", std::string(fingerName(Finger(f))).c_str(), s.haptics.fingers[f].force,
+                s.haptics.fingers[f].newtons);
+    ImGui::PlotLines(fmt::format("##force{}", f).c_str(), force_[f].data(), force_[f].size(), force_[f].offset(),
+                     nullptr, 0.0f, 1.0f, ImVec2(-1.0f, 40.0f));
   }
   for (const SceneBody& b : running_->scene.bodies)
     if (b.kind == BodyKind::Soft)

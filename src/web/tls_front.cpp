@@ -27,7 +27,10 @@ constexpr std::size_t kChunk = 16 * 1024;
 class Tunnel : public std::enable_shared_from_this<Tunnel> {
  public:
   Tunnel(tcp::socket socket, ssl::context& context, tcp::endpoint inner, TlsFront::Log log)
-      : outer_(std::move(socket), context), inner_(outer_.get_executor()), innerEndpoint_(inner), log_(std::move(log)) {}
+      : outer_(std::move(socket), context),
+        inner_(outer_.get_executor()),
+        innerEndpoint_(inner),
+        log_(std::move(log)) {}
 
   void start() {
     beast::get_lowest_layer(outer_).expires_after(kHandshakeTimeout);
@@ -55,14 +58,15 @@ class Tunnel : public std::enable_shared_from_this<Tunnel> {
  private:
   template <typename From, typename To>
   void pump(From& from, To& to, std::array<char, kChunk>& buffer) {
-    from.async_read_some(net::buffer(buffer), [self = shared_from_this(), &from, &to, &buffer](beast::error_code ec,
-                                                                                               std::size_t n) {
-      if (ec) return self->close();
-      net::async_write(to, net::buffer(buffer.data(), n), [self, &from, &to, &buffer](beast::error_code ec2, std::size_t) {
-        if (ec2) return self->close();
-        self->pump(from, to, buffer);
-      });
-    });
+    from.async_read_some(net::buffer(buffer),
+                         [self = shared_from_this(), &from, &to, &buffer](beast::error_code ec, std::size_t n) {
+                           if (ec) return self->close();
+                           net::async_write(to, net::buffer(buffer.data(), n),
+                                            [self, &from, &to, &buffer](beast::error_code ec2, std::size_t) {
+                                              if (ec2) return self->close();
+                                              self->pump(from, to, buffer);
+                                            });
+                         });
   }
 
   std::string peer() {

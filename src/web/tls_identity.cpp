@@ -99,8 +99,8 @@ TlsIdentity create(const std::vector<std::string>& addresses) {
   X509_gmtime_adj(X509_getm_notAfter(cert.get()), long(kValidDays) * 24 * 3600);
   X509_set_pubkey(cert.get(), key.get());
   X509_NAME* name = X509_get_subject_name(cert.get());
-  X509_NAME_add_entry_by_txt(name, "CN", MBSTRING_ASC, reinterpret_cast<const unsigned char*>("vrdeform serve"), -1,
-                             -1, 0);
+  X509_NAME_add_entry_by_txt(name, "CN", MBSTRING_ASC, reinterpret_cast<const unsigned char*>("vrdeform serve"), -1, -1,
+                             0);
   X509_set_issuer_name(cert.get(), name);
   std::string names = "DNS:localhost,IP:127.0.0.1,IP:::1";
   for (const std::string& a : addresses)
@@ -108,7 +108,8 @@ TlsIdentity create(const std::vector<std::string>& addresses) {
   X509V3_CTX ctx;
   X509V3_set_ctx_nodb(&ctx);
   X509V3_set_ctx(&ctx, cert.get(), cert.get(), nullptr, nullptr, 0);
-  for (const auto& [nid, value] : {std::pair{NID_subject_alt_name, names}, {NID_basic_constraints, "critical,CA:FALSE"},
+  for (const auto& [nid, value] : {std::pair{NID_subject_alt_name, names},
+                                   {NID_basic_constraints, "critical,CA:FALSE"},
                                    {NID_ext_key_usage, "serverAuth"}}) {
     Extension ext(X509V3_EXT_conf_nid(nullptr, &ctx, nid, value.c_str()));
     if (!ext || !X509_add_ext(cert.get(), ext.get(), -1)) fail("cannot add an extension");
