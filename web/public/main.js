@@ -32,6 +32,7 @@ const state = {
   xrPresenting: false,
   xrFrames: 0,
   inputsSent: 0,
+  mousePokes: 0,
   pulses: 0,
   lastError: null,
 };
@@ -155,10 +156,11 @@ function buildScene(info, topology) {
   if (first) {
     const top = new THREE.Vector3(...first.top);
     const centre = new THREE.Vector3(...first.min).add(new THREE.Vector3(...first.max)).multiplyScalar(0.5);
-    controls.target.copy(centre);
-    camera.position.copy(centre).add(new THREE.Vector3(0, 0.22, 0.38));
+    // The body and the force panel 6 cm above its top, both in view.
+    panel.mesh.position.copy(top).add(new THREE.Vector3(0, 0.06, 0));
+    controls.target.copy(centre).lerp(panel.mesh.position, 0.25);
+    camera.position.copy(controls.target).add(new THREE.Vector3(0, 0.22, 0.38));
     controls.update();
-    panel.mesh.position.copy(top).add(new THREE.Vector3(0, 0.1, 0));
   }
   placeRoot();
 }
@@ -200,7 +202,7 @@ function applyFrame(buffer) {
   frame.fingertips.forEach((p, f) => {
     const s = tips[f];
     if (!s) return;
-    s.visible = frame.present[f];
+    s.visible = frame.present[f] && frame.driven; // parked, out of the way, while nobody drives the hand
     s.position.set(p[0], p[1], p[2]);
     s.material.color.copy(TIP_COLOUR).lerp(PRESS_COLOUR, Math.min(1, frame.force[f]));
   });
@@ -212,6 +214,66 @@ function applyFrame(buffer) {
   state.contact = frame.contact;
   state.driven = frame.driven;
   state.glove = frame.glove;
+}
+
+// --- Poking with the mouse (desktop) -----------------------------------------------------------
+
+// A left press on a body pokes it: the index fingertip appears touching the surface under the
+// cursor and sinks in along the view ray to one fingertip radius over POKE_SECONDS, as in the
+// desktop viewer; it comes back out on release. A press off the bodies orbits the camera.
+const POKE_SECONDS = 0.5;
+const RETRACT = 0.05; // m back along the ray on release, before the server parks the hand
+const raycaster = new THREE.Raycaster();
+let mousePoke = null; // { point, direction, start } in scene coordinates while pressing
+
+function bodyUnder(event) {
+  const rect = renderer.domElement.getBoundingClientRect();
+  const ndc = new THREE.Vector2(
+    ((event.clientX - rect.left) / rect.width) * 2 - 1,
+    -((event.clientY - rect.top) / rect.height) * 2 + 1,
+  );
+  raycaster.setFromCamera(ndc, camera);
+  const meshes = bodies.filter((b) => b.mesh.visible).map((b) => b.mesh);
+  for (const m of meshes) m.geometry.computeBoundingSphere(); // the vertices move every frame
+  const hit = raycaster.intersectObjects(meshes, false)[0];
+  return hit ? { point: root.worldToLocal(hit.point.clone()), direction: raycaster.ray.direction.clone() } : null;
+}
+
+// The fingertips for the server: the index at `depth` past the surface along the ray, the others
+// where they are (null).
+function sendPoke(depth) {
+  if (!socket || socket.readyState !== WebSocket.OPEN || !mousePoke || !state.scene) return;
+  const r = state.scene.fingertipRadius || 0.009;
+  const index = mousePoke.point.clone().addScaledVector(mousePoke.direction, depth - r);
+  const tips = wire.FINGERS.map((name) => (name === 'index' ? index.toArray() : null));
+  socket.send(wire.inputMessage(null, { source: 'hand', tips }));
+  state.inputsSent++;
+}
+
+renderer.domElement.addEventListener(
+  'pointerdown',
+  (event) => {
+    if (renderer.xr.isPresenting || event.button !== 0 || !state.scene) return;
+    const hit = bodyUnder(event);
+    if (!hit) return; // the orbit controls take it
+    event.stopImmediatePropagation(); // before OrbitControls: no orbit while poking
+    renderer.domElement.setPointerCapture(event.pointerId);
+    mousePoke = { ...hit, start: performance.now() };
+    state.mousePokes++;
+  },
+  { capture: true },
+);
+renderer.domElement.addEventListener('pointerup', () => {
+  if (!mousePoke) return;
+  sendPoke(-RETRACT);
+  mousePoke = null;
+});
+
+function pokeStep() {
+  if (!mousePoke) return;
+  const r = (state.scene && state.scene.fingertipRadius) || 0.009;
+  const held = (performance.now() - mousePoke.start) / 1000;
+  sendPoke(r * Math.min(held / POKE_SECONDS, 1));
 }
 
 // --- The connection ----------------------------------------------------------------------------
@@ -354,6 +416,7 @@ renderer.setAnimationLoop((time, frame) => {
     sendInput(frame);
   } else {
     controls.update();
+    pokeStep();
   }
   drawPanel();
   renderer.render(scene, camera);
@@ -367,4 +430,11 @@ window.vrdeform = {
   toXr: (p) => [p[0] + root.position.x, p[1] + root.position.y, p[2] + root.position.z],
   vertex: (body, i) => Array.from(bodies[body].positions.subarray(3 * i, 3 * i + 3)),
   fingertips: () => tips.map((t) => (t.visible ? t.position.toArray() : null)),
+  // Where a point in scene coordinates is drawn on the desktop, in CSS pixels of the page.
+  screenOf: (p) => {
+    const v = root.localToWorld(new THREE.Vector3(...p)).project(camera);
+    const rect = renderer.domElement.getBoundingClientRect();
+    return [rect.left + ((v.x + 1) / 2) * rect.width, rect.top + ((1 - v.y) / 2) * rect.height];
+  },
+  panelCentre: () => panel.mesh.position.toArray(),
 };

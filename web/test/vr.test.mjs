@@ -247,3 +247,54 @@ test('the VR page over TLS: a secure context, the scene over WSS, immersive VR',
   const { code } = await exited;
   assert.equal(code, 0, output());
 });
+
+// The desktop page: the force panel is not under the info box, and a left press on the body pokes
+// it with the mouse (the server reports the index's force) until the button is released.
+test('the desktop page: the force panel in view, poking with the mouse', { timeout: 150000 }, async (t) => {
+  const { server, url, exited, output } = startServer();
+  const profile = mkdtempSync(path.join(tmpdir(), 'vrdeform-chromium-'));
+  let browser;
+  t.after(async () => {
+    if (browser) await browser.close().catch(() => {});
+    if (server.exitCode === null) server.kill('SIGKILL');
+    rmSync(profile, { recursive: true, force: true });
+  });
+  const base = await url;
+  const status = async () => (await fetch(`${base}status.json`)).json();
+  browser = await openHeadset(profile);
+  const page = browser.pages()[0] || (await browser.newPage());
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  await page.goto(base);
+  await until('the scene and mesh frames', () => page.evaluate(() => vrdeform.state.framesReceived > 3), 30000);
+
+  const [px, py] = await page.evaluate(() => vrdeform.screenOf(vrdeform.panelCentre()));
+  const box = await page.evaluate(() => {
+    const r = document.getElementById('overlay').getBoundingClientRect();
+    return { left: r.left, right: r.right, top: r.top, bottom: r.bottom };
+  });
+  assert.ok(px < box.left || px > box.right || py < box.top || py > box.bottom,
+            `the force panel (${px}, ${py}) is under the info box ${JSON.stringify(box)}`);
+
+  // The middle of the body's bounds on screen: the ray meets the body there.
+  const [x, y] = await page.evaluate(() => {
+    const b = vrdeform.state.scene.bodies[0];
+    return vrdeform.screenOf(b.min.map((v, k) => (v + b.max[k]) / 2));
+  });
+  await page.mouse.move(x, y);
+  await page.mouse.down();
+  const pressed = await until('a force from the mouse poke', async () => {
+    const s = await status();
+    return s.driven && s.force[1] > 0.05 ? s : null;
+  }).catch(async (e) => assert.fail(`${e.message}: ${JSON.stringify(await status())}`));
+  assert.ok(pressed.newtons[1] > 0, `index newtons ${pressed.newtons}`);
+  assert.equal(await page.evaluate(() => vrdeform.state.mousePokes), 1);
+  await page.mouse.up();
+  await until('the force to go once released', async () => (await status()).force[1] < 0.01);
+  assert.deepEqual(errors, [], `page errors: ${errors.join('\n')}`);
+  await browser.close();
+  browser = null;
+  server.kill('SIGTERM');
+  const { code } = await exited;
+  assert.equal(code, 0, output());
+});
