@@ -97,8 +97,11 @@ async function headsetPage(context) {
   return { page, errors };
 }
 
-test('the VR page in an emulated headset: both eyes, mesh frames, poke and grasp', { timeout: 150000 }, async (t) => {
-  const { server, url, exited, output } = startServer();
+// Starts `vrdeform serve liver` with `serverArgs`, then Chromium with the flags
+// `browserArgs(serverOutput)` gives; both are closed when the test ends. stop() closes the browser
+// and checks that the server stops cleanly on SIGTERM.
+async function serveAndBrowse(t, serverArgs = [], browserArgs = () => []) {
+  const { server, url, exited, output } = startServer(serverArgs);
   const profile = mkdtempSync(path.join(tmpdir(), 'vrdeform-chromium-'));
   let browser;
   t.after(async () => {
@@ -107,11 +110,21 @@ test('the VR page in an emulated headset: both eyes, mesh frames, poke and grasp
     rmSync(profile, { recursive: true, force: true });
   });
   const base = await url;
+  browser = await openHeadset(profile, browserArgs(output()));
+  const stop = async () => {
+    await browser.close();
+    browser = null;
+    server.kill('SIGTERM');
+    const { code } = await exited;
+    assert.equal(code, 0, output());
+  };
   const status = async () => (await fetch(`${base}status.json`)).json();
+  return { base, browser, output, status, stop };
+}
 
-  const context = await openHeadset(profile);
-  browser = context;
-  const { page, errors } = await headsetPage(context);
+test('the VR page in an emulated headset: both eyes, mesh frames, poke and grasp', { timeout: 150000 }, async (t) => {
+  const { base, browser, status, stop } = await serveAndBrowse(t);
+  const { page, errors } = await headsetPage(browser);
   await page.goto(base);
   await until('the scene and mesh frames', () => page.evaluate(() => vrdeform.state.framesReceived > 3), 30000);
   const scene = await page.evaluate(() => vrdeform.state.scene);
@@ -206,12 +219,7 @@ test('the VR page in an emulated headset: both eyes, mesh frames, poke and grasp
   assert.equal(stats.messagesRejected, 0, 'the page sends only valid messages');
   assert.ok(stats.inputs > 50, `inputs: ${stats.inputs}`);
 
-  // The server stops cleanly on SIGTERM.
-  await context.close();
-  browser = null;
-  server.kill('SIGTERM');
-  const { code } = await exited;
-  assert.equal(code, 0, output());
+  await stop();
 });
 
 // `serve --tls`: HTTPS and WSS with the self-signed certificate it made, which Chromium is told to
@@ -219,20 +227,14 @@ test('the VR page in an emulated headset: both eyes, mesh frames, poke and grasp
 // context, the scene over WSS and an immersive-vr session.
 test('the VR page over TLS: a secure context, the scene over WSS, immersive VR', { timeout: 150000 }, async (t) => {
   const certs = mkdtempSync(path.join(tmpdir(), 'vrdeform-tls-'));
-  const { server, url, exited, output } = startServer(['--tls', '--tls-dir', certs]);
-  const profile = mkdtempSync(path.join(tmpdir(), 'vrdeform-chromium-'));
-  let browser;
-  t.after(async () => {
-    if (browser) await browser.close().catch(() => {});
-    if (server.exitCode === null) server.kill('SIGKILL');
-    rmSync(profile, { recursive: true, force: true });
-    rmSync(certs, { recursive: true, force: true });
-  });
-  const base = await url;
+  t.after(() => rmSync(certs, { recursive: true, force: true }));
+  const trusted = (output) => {
+    const spki = output.match(/--ignore-certificate-errors-spki-list=(\S+)/);
+    assert.ok(spki, `no public-key hash printed:\n${output}`);
+    return [spki[0]];
+  };
+  const { base, browser, stop } = await serveAndBrowse(t, ['--tls', '--tls-dir', certs], trusted);
   assert.match(base, /^https:/);
-  const spki = output().match(/--ignore-certificate-errors-spki-list=(\S+)/);
-  assert.ok(spki, `no public-key hash printed:\n${output()}`);
-  browser = await openHeadset(profile, [`--ignore-certificate-errors-spki-list=${spki[1]}`]);
   const { page, errors } = await headsetPage(browser);
   await page.goto(base);
   assert.equal(await page.evaluate(() => window.isSecureContext), true);
@@ -241,27 +243,13 @@ test('the VR page over TLS: a secure context, the scene over WSS, immersive VR',
   await page.click('#VRButton');
   await until('an immersive-vr session', () => page.evaluate(() => vrdeform.state.xrPresenting && vrdeform.state.xrFrames > 10));
   assert.deepEqual(errors, [], `page errors: ${errors.join('\n')}`);
-  await browser.close();
-  browser = null;
-  server.kill('SIGTERM');
-  const { code } = await exited;
-  assert.equal(code, 0, output());
+  await stop();
 });
 
 // The desktop page: the force panel is not under the info box, and a left press on the body pokes
 // it with the mouse (the server reports the index's force) until the button is released.
 test('the desktop page: the force panel in view, poking with the mouse', { timeout: 150000 }, async (t) => {
-  const { server, url, exited, output } = startServer();
-  const profile = mkdtempSync(path.join(tmpdir(), 'vrdeform-chromium-'));
-  let browser;
-  t.after(async () => {
-    if (browser) await browser.close().catch(() => {});
-    if (server.exitCode === null) server.kill('SIGKILL');
-    rmSync(profile, { recursive: true, force: true });
-  });
-  const base = await url;
-  const status = async () => (await fetch(`${base}status.json`)).json();
-  browser = await openHeadset(profile);
+  const { base, browser, status, stop } = await serveAndBrowse(t);
   const page = browser.pages()[0] || (await browser.newPage());
   const errors = [];
   page.on('pageerror', (e) => errors.push(String(e)));
@@ -292,9 +280,5 @@ test('the desktop page: the force panel in view, poking with the mouse', { timeo
   await page.mouse.up();
   await until('the force to go once released', async () => (await status()).force[1] < 0.01);
   assert.deepEqual(errors, [], `page errors: ${errors.join('\n')}`);
-  await browser.close();
-  browser = null;
-  server.kill('SIGTERM');
-  const { code } = await exited;
-  assert.equal(code, 0, output());
+  await stop();
 });
