@@ -82,7 +82,7 @@ const char* toString(SurfaceDefect defect) {
     case SurfaceDefect::Empty:
       return "empty";
     case SurfaceDefect::NonFinite:
-      return "non-finite coordinate";
+      return "non-finite or out-of-range coordinate";
     case SurfaceDefect::BadIndex:
       return "bad vertex index";
     case SurfaceDefect::DegenerateFace:
@@ -144,11 +144,15 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
     return report;
   }
 
-  // Vertices and faces one by one.
+  // Vertices and faces one by one. A coordinate beyond kMaxCoordinate is as unusable as a NaN: its
+  // faces' areas and normals lose every digit (a float keeps 7), so it is reported as such
+  // instead of as the degenerate faces it makes.
+  constexpr float kMaxCoordinate = 1e15f;
   std::vector<char> finite(nv);
   std::vector<Index> nonFinite;
   for (std::size_t v = 0; v < nv; ++v)
-    if (!(finite[v] = isFinite(mesh.vertices[v]))) nonFinite.push_back(Index(v));
+    if (!(finite[v] = isFinite(mesh.vertices[v]) && mesh.vertices[v].cwiseAbs().maxCoeff() <= kMaxCoordinate))
+      nonFinite.push_back(Index(v));
 
   std::vector<FaceState> state(nf, FaceState::Good);
   std::vector<Index> badIndex, degenerate;
@@ -195,12 +199,14 @@ SurfaceReport checkSurface(const TriMesh& mesh, const SurfaceCheckOptions& optio
           usedBy = fmt::format("in face {}", f + 1);
           break;
         }
-      details.push_back(fmt::format("vertex {} = ({}, {}, {}) {}", oneBased(v), x.x(), x.y(), x.z(), usedBy));
+      details.push_back(fmt::format("vertex {} = ({}, {}, {}) {}{}", oneBased(v), x.x(), x.y(), x.z(), usedBy,
+                                    isFinite(x) ? fmt::format(", beyond +-{:g}", kMaxCoordinate) : ""));
     }
     add(SurfaceDefect::NonFinite, nonFinite.size(), nonFinite,
-        nonFinite.size() == 1 ? fmt::format("a vertex has a non-finite coordinate: {}", details[0])
-                              : fmt::format("{} vertices have non-finite coordinates: {}{}", nonFinite.size(),
-                                            fmt::join(details, "; "), nonFinite.size() > listed ? "; ..." : ""));
+        nonFinite.size() == 1
+            ? fmt::format("a vertex has a non-finite or out-of-range coordinate: {}", details[0])
+            : fmt::format("{} vertices have non-finite or out-of-range coordinates: {}{}", nonFinite.size(),
+                          fmt::join(details, "; "), nonFinite.size() > listed ? "; ..." : ""));
   }
   if (!badIndex.empty())
     add(SurfaceDefect::BadIndex, badIndex.size(), badIndex,

@@ -415,6 +415,16 @@ TEST(SurfaceCheck, NonFiniteCoordinate) {
 
   mesh.vertices[5].z() = std::numeric_limits<float>::infinity();
   EXPECT_EQ(issueOf(checkSurface(mesh), SurfaceDefect::NonFinite).firstFaces, ids({3, 5}));
+
+  // A coordinate of 1e38 is a number, but out of range: said so, not taken for degenerate faces.
+  TriMesh huge = makeCubeSurface();
+  huge.vertices[2].y() = 1e38f;
+  const SurfaceReport far = checkSurface(huge);
+  const SurfaceIssue& range = issueOf(far, SurfaceDefect::NonFinite);
+  EXPECT_EQ(range.firstFaces, ids({2}));
+  EXPECT_TRUE(contains(range.message, "vertex 3 = (")) << range.message;
+  EXPECT_TRUE(contains(range.message, "out-of-range")) << range.message;
+  for (const SurfaceIssue& i : far.issues) EXPECT_NE(i.defect, SurfaceDefect::DegenerateFace) << i.message;
 }
 
 TEST(SurfaceCheck, DegenerateFaces) {

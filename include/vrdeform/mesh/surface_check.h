@@ -12,7 +12,7 @@ namespace vrd {
 
 enum class SurfaceDefect {
   Empty,                    ///< no faces
-  NonFinite,                ///< a vertex coordinate is NaN or infinite
+  NonFinite,                ///< a vertex coordinate is NaN, infinite or beyond +-1e15 (no digits left for its faces)
   BadIndex,                 ///< a face refers to a vertex that does not exist
   DegenerateFace,           ///< a repeated vertex index, or zero area (kDegenerateShape)
   NonManifoldEdge,          ///< an edge shared by three or more faces
