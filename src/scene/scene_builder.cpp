@@ -70,6 +70,9 @@ PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log, const std::f
     const auto start = std::chrono::steady_clock::now();
     TetrahedraliseOptions mesher = body.mesher;
     mesher.stop = stop;
+    if (mesher.mesher == Mesher::TetGen)  // seconds to minutes, where the built-in mesher takes milliseconds
+      say(log, fmt::format("mesh: {} ({} triangles): meshing with tetgen (at most {:g} s a run)...", name,
+                           surface.triangles.size(), mesher.timeoutSeconds));
     Tetrahedralisation made = tetrahedralise(surface, mesher);
     out.tets = std::move(made.mesh);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
