@@ -70,67 +70,68 @@ ElasticModuli& moduli(SceneSpec& s) { return *body(s).material.elastic; }  // a 
 // (sceneOfMesh: the scene files' defaults, which it changes). Throws vrd::Error in option terms.
 struct SceneOption {
   const char* name;
+  const char* type;  // in the help: what the value is
   const char* help;
   void (*apply)(SceneSpec&, const std::string&);
 };
 
 constexpr SceneOption kSceneOptions[] = {
-    {"scale", "Multiplies the coordinates (0.001 for millimetres; default 1)",
+    {"scale", "FACTOR", "Multiplies the coordinates (0.001 for millimetres; default 1)",
      [](SceneSpec& s, const std::string& t) { body(s).scale = positive("scale", t); }},
-    {"tets", "Surfaces: approximate tet count of the built-in mesher (default: its own, about 1000)",
+    {"tets", "N", "Surfaces: approximate tet count of the built-in mesher (default: its own, about 1000)",
      [](SceneSpec& s, const std::string& t) {
        body(s).mesher.targetTets = std::size_t(whole("tets", t, 6, 2'000'000));
      }},
-    {"youngs", "Young's modulus (Pa; default 3e4, soft tissue)",
+    {"youngs", "PA", "Young's modulus (Pa; default 3e4, soft tissue)",
      [](SceneSpec& s, const std::string& t) { moduli(s).youngsModulus = positive("youngs", t); }},
-    {"poisson", "Poisson ratio, in [0, 0.5) (default 0.45)",
+    {"poisson", "NU", "Poisson ratio, in [0, 0.5) (default 0.45)",
      [](SceneSpec& s, const std::string& t) {
        moduli(s).poissonRatio = checked<float>("poisson", t, 0.0, std::nextafter(0.5, 0.0), "in [0, 0.5)");
      }},
-    {"density", "Density (kg/m^3; default 1060)",
+    {"density", "KG_M3", "Density (kg/m^3; default 1060)",
      [](SceneSpec& s, const std::string& t) { moduli(s).density = positive("density", t); }},
-    {"damping", "Rayleigh (stiffness-proportional) damping time (s; default 0.005)",
+    {"damping", "SECONDS", "Rayleigh (stiffness-proportional) damping time (s; default 0.005)",
      [](SceneSpec& s, const std::string& t) { moduli(s).rayleighDamping = nonNegative("damping", t); }},
-    {"rate", "Simulation steps per second (default 60)",
+    {"rate", "HZ", "Simulation steps per second (default 60)",
      [](SceneSpec& s, const std::string& t) { s.solver.timeStep = 1.0 / whole("rate", t, 1, 100'000); }},
-    {"substeps", "Substeps per step (default 8)",
+    {"substeps", "N", "Substeps per step (default 8)",
      [](SceneSpec& s, const std::string& t) { s.solver.substeps = whole("substeps", t, 1, 1000); }},
-    {"iterations", "Gauss-Seidel iterations per substep (default 5)",
+    {"iterations", "N", "Gauss-Seidel iterations per substep (default 5)",
      [](SceneSpec& s, const std::string& t) { s.solver.iterations = whole("iterations", t, 1, 1000); }},
-    {"damping-linear", "Velocity damping (1/s; default 0)",
+    {"damping-linear", "PER_SECOND", "Velocity damping (1/s; default 0)",
      [](SceneSpec& s, const std::string& t) { s.solver.linearDamping = nonNegative("damping-linear", t); }},
-    {"settle", "Seconds the body settles before the hand appears (default: until it is at rest, at most 20)",
+    {"settle", "SECONDS", "Seconds the body settles before the hand appears (default: until it is at rest, at most 20)",
      [](SceneSpec& s, const std::string& t) {
        s.settle = checked<double>("settle", t, 0, 600, "in [0, 600] seconds");
        s.settleToRest = false;
      }},
-    {"hand", "g1 (thumb, index, middle; the default) or pro (five fingers)",
+    {"hand", "g1|pro", "g1 (thumb, index, middle; the default) or pro (five fingers)",
      [](SceneSpec& s, const std::string& t) {
        static constexpr std::pair<std::string_view, bool> kHands[] = {{"g1", false}, {"pro", true}};
        s.hand.rig.fingers = (choice("hand", t, kHands) ? HandRigSettings::pro() : HandRigSettings::g1()).fingers;
      }},
-    {"contact", "triangles (the default) or particles: what the fingertips touch",
+    {"contact", "triangles|particles", "triangles (the default) or particles: what the fingertips touch",
      [](SceneSpec& s, const std::string& t) {
        static constexpr std::pair<std::string_view, FingertipContactMode> kContacts[] = {
            {"triangles", FingertipContactMode::Triangles}, {"particles", FingertipContactMode::Particles}};
        s.hand.rig.contact = choice("contact", t, kContacts);
      }},
-    {"grasp", "local (the default), paper (eq. 35) or off",
+    {"grasp", "local|paper|off", "local (the default), paper (eq. 35) or off",
      [](SceneSpec& s, const std::string& t) {
        static constexpr std::pair<std::string_view, int> kGrasps[] = {{"local", 0}, {"paper", 1}, {"off", 2}};
        const int g = choice("grasp", t, kGrasps);
        s.hand.grasp.enabled = g != 2;
        s.hand.grasp.mode = g == 1 ? GraspMode::Paper : GraspMode::Local;
      }},
-    {"alpha", "Smoothing factor per step (eq. 44), in (0, 1]",
+    {"alpha", "ALPHA", "Smoothing factor per step (eq. 44), in (0, 1]",
      [](SceneSpec& s, const std::string& t) {
        s.haptics.settings.signal.alphaT = checked<float>("alpha", t, 1e-30, 1, "in (0, 1]");
      }},
-    {"beta-contact", "Weight of the contact term (eq. 43), in [0, 1]",
+    {"beta-contact", "BETA", "Weight of the contact term (eq. 43), in [0, 1]",
      [](SceneSpec& s, const std::string& t) {
        s.haptics.settings.signal.betaContact = checked<float>("beta-contact", t, 0, 1, "in [0, 1]");
      }},
-    {"max-change", "Largest change of a force per ms (inf: no limit)",
+    {"max-change", "PER_MS", "Largest change of a force per ms (inf: no limit)",
      [](SceneSpec& s, const std::string& t) {
        s.haptics.settings.maxChangePerMs =
            t == "inf" ? std::numeric_limits<float>::infinity() : positive("max-change", t);
@@ -242,7 +243,8 @@ std::function<int()> addTouchCommand(CLI::App& app) {
   std::vector<CLI::Option*> sceneOptions;
   for (std::size_t i = 0; i < std::size(kSceneOptions); ++i)
     sceneOptions.push_back(
-        cmd->add_option(fmt::format("--{}", kSceneOptions[i].name), args->values[i], kSceneOptions[i].help));
+        cmd->add_option(fmt::format("--{}", kSceneOptions[i].name), args->values[i], kSceneOptions[i].help)
+            ->type_name(kSceneOptions[i].type));
   sceneOptions.push_back(
       cmd->add_flag("--no-calibrate", args->noCalibrate, "Keep the default haptic scales (tau = 1)"));
   cmd->add_option("--script", args->script, "Hand script (docs/hand-input.md); default: the standard poke");
