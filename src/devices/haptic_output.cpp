@@ -1,5 +1,7 @@
 #include "vrdeform/devices/haptic_output.h"
 
+#include "vrdeform/haptics/haptic_session.h"
+
 namespace vrd {
 namespace {
 

@@ -10,10 +10,11 @@
 #include <string_view>
 
 #include "vrdeform/haptics/haptic_model.h"
-#include "vrdeform/haptics/haptic_session.h"
 #include "vrdeform/interact/hand.h"
 
 namespace vrd {
+
+class HapticSession;
 
 /// One step of the haptic signal as outputs see it: what the glove gets (force, paper) and what a
 /// study logs beside it. Finger order: thumb, index, middle, ring, little; absent fingers read 0.
