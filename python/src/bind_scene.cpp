@@ -121,6 +121,18 @@ void bindScene(py::module_& m) {
       },
       py::arg("text"), py::arg("base_dir") = std::filesystem::path("."),
       "A scene from TOML text; mesh paths are relative to base_dir");
+  m.def(
+      "scene_of_mesh",
+      [](const std::filesystem::path& mesh, float scale) {
+        if (!(scale > 0.0f && std::isfinite(scale)))
+          throw Error(fmt::format("scene_of_mesh: scale must be a positive number, got {}", scale));
+        SceneSpec spec = sceneOfMesh(mesh);
+        spec.bodies.front().scale = scale;
+        return spec;
+      },
+      py::arg("mesh"), py::arg("scale") = 1.0f,
+      "The scene of one mesh on the ground with the scene files' defaults (`vrdeform touch` without its poke); "
+      "scale 0.001 for a mesh in millimetres");
   m.def("builtin_scenes", [] {
     std::vector<std::string> names;
     for (const SceneEntry& e : builtinScenes()) names.push_back(e.name);

@@ -107,6 +107,22 @@ def test_ctrl_c_stops_settling():
     timer.join()
 
 
+def test_scene_of_mesh_gives_the_scene_files_defaults():
+    meshes = pathlib.Path(vrdeform.load_scene("liver").source).parent.parent / "data" / "meshes"
+    spec = vrdeform.scene_of_mesh(meshes / "liver_coarse.obj", scale=0.001)
+    assert spec.name == "liver_coarse" and spec.bodies == ["body1"]
+    assert spec.solver.substeps == 8 and spec.settle_to_rest and spec.hand_enabled
+    spec.settle, spec.settle_to_rest, spec.calibrate = 0.5, False, False
+    scene = vrdeform.build_scene(spec)
+    summary = scene.run(steps=5)
+    height = np.array(scene.world.positions(scene.bodies["body1"]))[:, 1].max()
+    assert summary["ok"] and 0.1 < height < 0.2  # 17 cm: the millimetres scaled
+    with pytest.raises(vrdeform.Error, match="scale must be a positive number"):
+        vrdeform.scene_of_mesh(meshes / "liver_coarse.obj", scale=0.0)
+    with pytest.raises(vrdeform.Error, match="no such file"):
+        vrdeform.scene_of_mesh(meshes / "nope.obj")
+
+
 def test_a_scene_of_a_mesh_alone(tmp_path):
     meshes = pathlib.Path(vrdeform.load_scene("liver").source).parent.parent / "data" / "meshes"
     text = """

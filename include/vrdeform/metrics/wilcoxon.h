@@ -9,13 +9,13 @@
 namespace vrd {
 
 struct WilcoxonResult {
-  std::size_t n = 0;       ///< pairs with a non-zero difference (zero differences are dropped)
-  double wPlus = 0.0;      ///< sum of the ranks of the positive differences a - b (ties: mean ranks)
-  double wMinus = 0.0;     ///< the same for the negative ones; wPlus + wMinus = n (n + 1) / 2
-  double p = 1.0;          ///< two-sided p-value
-  bool exact = false;      ///< p from the exact distribution of W+ (else the normal approximation)
-  double z = 0.0;          ///< (W+ - n (n + 1) / 4) / sd, the sd corrected for ties
-  double effectSize = 0.0; ///< r = |z| / sqrt(n)
+  std::size_t n = 0;        ///< pairs with a non-zero difference (zero differences are dropped)
+  double wPlus = 0.0;       ///< sum of the ranks of the positive differences a - b (ties: mean ranks)
+  double wMinus = 0.0;      ///< the same for the negative ones; wPlus + wMinus = n (n + 1) / 2
+  double p = 1.0;           ///< two-sided p-value
+  bool exact = false;       ///< p from the exact distribution of W+ (else the normal approximation)
+  double z = 0.0;           ///< (W+ - n (n + 1) / 4) / sd, the sd corrected for ties
+  double effectSize = 0.0;  ///< r = |z| / sqrt(n)
 };
 
 /// Tests whether the differences a[i] - b[i] are symmetric about 0. Exact (the distribution of W+
