@@ -55,9 +55,10 @@ HapticSample sampleOf(std::uint64_t step, const HapticSession& session) {
   HapticSample sample = sampleOf(step, session.world().settings().timeStep, session.haptics(), rig.settings().fingers);
   sample.grasp = session.grasp().active();
   for (int f = 0; f < kFingerCount; ++f)
-    if (sample.present[f] && rig.has(Finger(f)))
-      sample.tip[f] = session.world().fingertip(rig.fingertip(Finger(f))).center;
-  return sanitised(sample);
+    if (sample.present[f] && rig.has(Finger(f)))  // the rest is sanitised already: only the tips are new
+      sample.tip[f] =
+          session.world().fingertip(rig.fingertip(Finger(f))).center.unaryExpr([](float v) { return finiteOrZero(v); });
+  return sample;
 }
 
 }  // namespace vrd
