@@ -148,6 +148,14 @@ BodyId World::addBody(std::shared_ptr<const BodyModel> model, const Vec3& transl
     particleBody_.push_back(id);
   }
   bodies_.push_back(std::move(body));
+  ContactSurface surface;
+  for (const Triangle& t : model->surface) surface.vertices.insert(surface.vertices.end(), t.begin(), t.end());
+  std::sort(surface.vertices.begin(), surface.vertices.end());
+  surface.vertices.erase(std::unique(surface.vertices.begin(), surface.vertices.end()), surface.vertices.end());
+  surface.firstKey = id == 0 ? 0 : contactSurfaces_.back().firstKey + Index(bodies_[id - 1].model->surface.size());
+  surface.closed = !model->tets.empty();
+  contactSurfaces_.push_back(std::move(surface));
+  bodyContactSettings_.emplace_back();
   frameColliders();
   frameFingertips();
   return id;
@@ -333,6 +341,8 @@ void World::step() {
   report_.fingertipContacts =
       std::size_t(std::count_if(fingertipLambda_.begin(), fingertipLambda_.end(), pushed) +
                   std::count_if(fingertipTriangleLambda_.begin(), fingertipTriangleLambda_.end(), pushed));
+  report_.bodyContacts = std::size_t(std::count_if(bodyContactLambda_.begin(), bodyContactLambda_.end(), pushed));
+  report_.deepestPenetration = deepestPenetration();
   publish();
   ++stepCount_;
 }
@@ -495,6 +505,7 @@ void World::detectContacts(const SolverTeam& team) {
     previousColliderContacts_.swap(colliderContacts_);
     previousFingertipContacts_.swap(fingertipContacts_);
     previousTriangleContacts_.swap(fingertipTriangleContacts_);
+    previousBodyContacts_.swap(bodyContacts_);
   }
   collider.clear();
   fingertip.clear();
@@ -507,6 +518,7 @@ void World::detectContacts(const SolverTeam& team) {
       fingertipContacts_.insert(fingertipContacts_.end(), other.fingertip.begin(), other.fingertip.end());
     }
     detectTriangleContacts();
+    detectBodyContacts();
   }
   resetMultipliers(team);
 }
@@ -683,6 +695,7 @@ void World::resetMultipliers(const SolverTeam& team) {
         pred[con.i[k]].pos += pred[con.i[k]].w * fingertipTriangleImpulse_[c][k];
       }
     }
+    carryBodyContacts();
     if (warmPushesFit()) return;
     // Too far for a guess: this substep starts cold, from the inertial predictions.
     ++report_.coldSubsteps;
@@ -700,6 +713,23 @@ void World::resetMultipliers(const SolverTeam& team) {
   fingertipTriangleLambda_.assign(fingertipTriangleContacts_.size(), 0.0f);
   fingertipTriangleFrictionLambda_.assign(fingertipTriangleContacts_.size(), Vec3::Zero());
   fingertipTriangleImpulse_.assign(fingertipTriangleContacts_.size(), {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
+  bodyContactLambda_.assign(bodyContacts_.size(), 0.0f);
+  bodyContactFrictionLambda_.assign(bodyContacts_.size(), Vec3::Zero());
+}
+
+// Body contacts found again keep their multipliers and push as they did, along their contact
+// planes (fixed over a substep, so the inertial predictions' gradients are the solver's).
+void World::carryBodyContacts() {
+  const std::vector<std::size_t> same = sameContacts(previousBodyContacts_, bodyContacts_, &BodyContact::triangle);
+  carry(bodyContactLambda_, same, 0.0f);
+  carry(bodyContactFrictionLambda_, same, Vec3(Vec3::Zero()));
+  Point* const pred = predicted_.data();
+  for (std::size_t c = 0; c < bodyContacts_.size(); ++c) {
+    const BodyContact& con = bodyContacts_[c];
+    const Vec3 push = bodyContactLambda_[c] * con.normal + bodyContactFrictionLambda_[c];
+    pred[con.particle].pos += pred[con.particle].w * push;
+    for (int k = 0; k < 3; ++k) pred[con.corner[k]].pos -= (pred[con.corner[k]].w * con.b[std::size_t(k)]) * push;
+  }
 }
 
 namespace {
@@ -1022,9 +1052,10 @@ void World::solveWorldConstraints(float invH, bool timed, const SolverTeam& team
       q.pos += q.w * friction;
     }
   }
+  if (fingertipTriangleContacts_.empty() && bodyContacts_.empty()) return;
+  team.barrier();  // a triangle's corners may be any member's
+  if (!team.leader()) return;
   if (!fingertipTriangleContacts_.empty()) {
-    team.barrier();  // a triangle's corners may be any member's
-    if (!team.leader()) return;
     StageTimer t(times, Stage::Fingertip, timed);
     for (std::size_t c = 0; c < fingertipTriangleContacts_.size(); ++c) {
       const FingertipTriangleContact& con = fingertipTriangleContacts_[c];
@@ -1048,6 +1079,10 @@ void World::solveWorldConstraints(float invH, bool timed, const SolverTeam& team
         corner[k]->pos += corner[k]->w * friction.b[k] * friction.dLambda;
       }
     }
+  }
+  if (!bodyContacts_.empty()) {
+    StageTimer t(times, Stage::BodyContact, timed);
+    solveBodyContacts(invH);
   }
 }
 
@@ -1249,6 +1284,13 @@ std::vector<Vec3> World::particleConstraintForces(BodyId id) const {
   for (std::size_t c = 0; c < fingertipTriangleContacts_.size(); ++c)
     for (int k = 0; k < 3; ++k)
       if (Vec3* fi = local(fingertipTriangleContacts_[c].i[k])) *fi += fingertipTriangleImpulse_[c][k] * invH2;
+  for (std::size_t c = 0; c < bodyContacts_.size(); ++c) {
+    const BodyContact& con = bodyContacts_[c];
+    const Vec3 push = (bodyContactLambda_[c] * con.normal + bodyContactFrictionLambda_[c]) * invH2;
+    if (Vec3* fi = local(con.particle)) *fi += push;
+    for (int k = 0; k < 3; ++k)
+      if (Vec3* fi = local(con.corner[k])) *fi -= con.b[std::size_t(k)] * push;
+  }
   return f;
 }
 

@@ -10,7 +10,7 @@ namespace vrd {
 
 enum class Stage : std::uint8_t {
   Predict,        ///< forces, damping and predicted positions (Algorithm 1, lines 6-8)
-  Detect,         ///< collider and fingertip contact detection, and the multipliers zeroed (lines 9-11)
+  Detect,         ///< collider, fingertip and body contact detection, and the multipliers zeroed (lines 9-11)
   Distance,       ///< stretch constraints
   Volume,         ///< tet volume constraints
   Strain,         ///< tet strain constraints
@@ -20,6 +20,7 @@ enum class Stage : std::uint8_t {
   Attachment,     ///< attachments
   Contact,        ///< collider contacts with friction
   Fingertip,      ///< fingertip contacts
+  BodyContact,    ///< contacts between bodies and of a body with itself (detected under Detect)
   Finalise,       ///< velocity update, commit, NaN check (lines 18-21)
   Interact,       ///< hand input and grasp (Algorithm 2, lines 3-10), measured by a haptic session
   Force,          ///< haptic force model (Algorithm 2, lines 24-41), measured by a haptic session

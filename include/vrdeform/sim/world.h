@@ -13,8 +13,10 @@
 #include "vrdeform/metrics/stage_times.h"
 #include "vrdeform/sim/attachment.h"
 #include "vrdeform/sim/body.h"
+#include "vrdeform/sim/body_contact.h"
 #include "vrdeform/sim/contact.h"
 #include "vrdeform/sim/solver_settings.h"
+#include "vrdeform/sim/spatial_hash.h"
 
 namespace vrd {
 
@@ -55,6 +57,10 @@ struct StepReport {
   int coldSubsteps = 0;  ///< with SolverSettings::warmStart: substeps whose warm start moved too far, started cold
   std::size_t colliderContacts = 0;   ///< contacts that pushed (lambda > 0) in the last substep
   std::size_t fingertipContacts = 0;  ///< fingertip contacts (particles and triangles) that pushed in the last substep
+  std::size_t bodyContacts = 0;       ///< body-body and self contacts that pushed in the last substep
+  /// The farthest a vertex ended the step past a surface triangle it touches (m): 0 while every
+  /// contact keeps its vertex on the outer side.
+  float deepestPenetration = 0.0f;
 };
 
 class World {
@@ -139,6 +145,21 @@ class World {
   const std::vector<FingertipTriangleContact>& fingertipTriangleContacts() const { return fingertipTriangleContacts_; }
   const std::vector<float>& fingertipTriangleContactLambda() const { return fingertipTriangleLambda_; }
 
+  // --- Contact between bodies and within a body ------------------------------------------------------
+  /// How a body touches other bodies and itself; throws vrd::Error for a negative or non-finite
+  /// thickness, friction or compliance. By default bodies touch each other and not themselves.
+  void setBodyContact(BodyId id, const BodyContactSettings& settings);
+  const BodyContactSettings& bodyContact(BodyId id) const { return bodyContactSettings_.at(id); }
+  /// Switches contact between two different bodies off (or back on); both must touch bodies too.
+  void setPairContact(BodyId a, BodyId b, bool enabled);
+  bool pairContact(BodyId a, BodyId b) const;
+  /// The last substep's body contacts, in particle order, and their normal multipliers (same order).
+  const std::vector<BodyContact>& bodyContacts() const { return bodyContacts_; }
+  const std::vector<float>& bodyContactLambda() const { return bodyContactLambda_; }
+  /// Total force the contacts between body `by`'s surface and body `on`'s applied to `on` in the
+  /// last substep, normal and friction (N); by == on: a body's self-contact, which nets to zero.
+  Vec3 bodyContactForce(BodyId on, BodyId by) const;
+
   // --- Stepping ---------------------------------------------------------------------------------
   /// Advances the world by one time step: `substeps` x (predict, detect, `iterations` Gauss-Seidel
   /// sweeps, finalise).
@@ -175,6 +196,10 @@ class World {
   void detectParticleContacts(const SolverTeam& team, std::vector<ColliderContact>& colliderContacts,
                               std::vector<FingertipContact>& fingertipContacts) const;
   void detectTriangleContacts();
+  void detectBodyContacts();
+  void solveBodyContacts(float invH);
+  void carryBodyContacts();  // warm start: carries their multipliers over and pushes by them
+  float deepestPenetration() const;
   void resetMultipliers(const SolverTeam& team);
   void coldStart(BodyId id);                                             // zeroes the body's multipliers
   void warmStart(const sweeps::LanePlan& plan, const SolverTeam& team);  // moves the predictions by the multipliers
@@ -223,10 +248,33 @@ class World {
   std::vector<float> fingertipTriangleLambda_;
   std::vector<Vec3> fingertipTriangleFrictionLambda_;
   std::vector<std::array<Vec3, 3>> fingertipTriangleImpulse_;  // per corner: sum of grad C dLambda this substep
+  // Body contact: each body's settings and surface, the pairs switched off, the contacts.
+  struct ContactSurface {
+    std::vector<Index> vertices;        // the surface's vertices (body-local, ascending)
+    std::vector<Index> neighbourStart;  // self-contact: particles sharing a tet (a cloth: a triangle)
+    std::vector<Index> neighbours;      //   with v, ascending, at neighbours[neighbourStart[v], [v + 1])
+    Index firstKey = 0;                 // the key (BodyContact::triangle) of its first triangle
+    bool closed = false;                // a soft body's boundary (outward); a cloth is two-sided
+  };
+  std::vector<BodyContactSettings> bodyContactSettings_;
+  std::vector<ContactSurface> contactSurfaces_;
+  std::vector<std::pair<BodyId, BodyId>> pairsOff_;  // (lower, higher), sorted
+  std::vector<BodyContact> bodyContacts_;
+  std::vector<float> bodyContactLambda_;
+  std::vector<Vec3> bodyContactFrictionLambda_;
+  SpatialHash contactHash_;
+  struct ContactTriangle {
+    BodyId body;
+    Index triangle;  // in the body's surface
+  };
+  std::vector<ContactTriangle> contactTriangles_;  // the broad phase's items, and their swept boxes
+  std::vector<Box3f> contactBoxes_;
+  std::vector<Index> contactSeen_;  // per item: the last vertex that met it
   // The last substep's contacts, whose multipliers a warm start carries over.
   std::vector<ColliderContact> previousColliderContacts_;
   std::vector<FingertipContact> previousFingertipContacts_;
   std::vector<FingertipTriangleContact> previousTriangleContacts_;
+  std::vector<BodyContact> previousBodyContacts_;
   std::vector<SimEvent> events_;
   // A team's scratch: each member's contacts before the leader joins them (the leader's own go
   // straight to the lists), and which members found their share of each body finite.
