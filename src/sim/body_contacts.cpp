@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "vrdeform/error.h"
 #include "vrdeform/sim/world.h"
@@ -17,25 +18,6 @@ void checkNonNegative(float value, const char* what) {
     throw Error(fmt::format("setBodyContact: {} must be finite and >= 0 (got {})", what, value));
 }
 
-// For each particle, the particles that share an element (a tet, or a cloth's triangle) with it.
-template <typename Element>
-void neighboursOf(const std::vector<Element>& elements, std::size_t particles, std::vector<Index>& start,
-                  std::vector<Index>& out) {
-  std::vector<std::vector<Index>> lists(particles);
-  for (const Element& e : elements)
-    for (Index a : e)
-      for (Index b : e)
-        if (a != b) lists[a].push_back(b);
-  start.assign(particles + 1, 0);
-  out.clear();
-  for (std::size_t v = 0; v < particles; ++v) {
-    std::sort(lists[v].begin(), lists[v].end());
-    lists[v].erase(std::unique(lists[v].begin(), lists[v].end()), lists[v].end());
-    out.insert(out.end(), lists[v].begin(), lists[v].end());
-    start[v + 1] = Index(out.size());
-  }
-}
-
 Vec3 offsetBetween(const Body& from, const Body& to) { return (from.origin - to.origin).cast<float>(); }
 
 }  // namespace
@@ -46,14 +28,6 @@ void World::setBodyContact(BodyId id, const BodyContactSettings& settings) {
   checkNonNegative(settings.staticFriction, "static friction");
   checkNonNegative(settings.dynamicFriction, "dynamic friction");
   checkNonNegative(settings.compliance, "compliance");
-  ContactSurface& s = contactSurfaces_[id];
-  const BodyModel& m = *bodies_[id].model;
-  if (settings.self && s.neighbourStart.empty()) {
-    if (m.tets.empty())
-      neighboursOf(m.triangles, m.particleCount(), s.neighbourStart, s.neighbours);
-    else
-      neighboursOf(m.tets, m.particleCount(), s.neighbourStart, s.neighbours);
-  }
   bodyContactSettings_[id] = settings;
 }
 
@@ -71,44 +45,77 @@ bool World::pairContact(BodyId a, BodyId b) const {
   return !std::binary_search(pairsOff_.begin(), pairsOff_.end(), std::pair{std::min(a, b), std::max(a, b)});
 }
 
-// Each substep, from the positions at its start and the predictions: every surface vertex whose
-// swept box (grown by its body's thickness) meets a surface triangle's swept box (grown by the
-// other's) is a candidate, and becomes a contact where its contact plane (touchVertexTriangle, at
-// the substep's start) is within the gap plus the pair's motion in the substep: so a vertex that
-// would cross a triangle within the substep meets its plane first, however fast (no tunnelling
-// from a state without penetration). A vertex more than the gap behind a plane is taken for the
-// far side of a thin part and left alone. Self-contact leaves out the triangles that hold the
-// vertex or a particle sharing a tet (a cloth: a triangle) with it, and those within the gap of it
-// in the rest shape.
+World::ContactSurface World::contactSurfaceOf(const BodyModel& model) {
+  ContactSurface surface;
+  for (const Triangle& t : model.surface) {
+    surface.vertices.insert(surface.vertices.end(), t.begin(), t.end());
+    for (int k = 0; k < 3; ++k)
+      surface.edges.push_back({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
+  }
+  const auto sortUnique = [](auto& v) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+  };
+  sortUnique(surface.vertices);
+  sortUnique(surface.edges);
+  for (const Triangle& t : model.surface) {
+    std::array<Index, 3> e;
+    for (int k = 0; k < 3; ++k) {
+      const std::array<Index, 2> edge{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])};
+      e[std::size_t(k)] =
+          Index(std::lower_bound(surface.edges.begin(), surface.edges.end(), edge) - surface.edges.begin());
+    }
+    surface.triangleEdges.push_back(e);
+  }
+  surface.closed = !model.tets.empty();
+  return surface;
+}
+
+bool World::touching(BodyId a, BodyId b) const {
+  const BodyContactSettings &sa = bodyContactSettings_[a], &sb = bodyContactSettings_[b];
+  return a == b ? sa.self : sa.bodies && sb.bodies && pairContact(a, b);
+}
+
+Box3f World::sweptBox(Index i, const Vec3& offset, float grow) const {
+  Box3f box(local_[i].pos + offset);
+  box.extend(predicted_[i].pos + offset);
+  return Box3f(box.min().array() - grow, box.max().array() + grow);
+}
+
+// Each substep, from the positions at its start and the predictions, through a spatial hash of
+// the surface triangles' swept boxes (start to prediction, grown by twice their body's thickness):
+// every surface vertex, and every surface edge, whose swept box meets a triangle's is a candidate
+// against it (an edge: against its edges), and becomes a contact where its contact plane
+// (touchVertexTriangle, touchEdgeEdge, at the substep's start) is within twice the gap plus the
+// pair's motion in the substep. The second gap is a skin: a vertex resting on a surface stays in
+// the set instead of leaving it whenever it lifts by a rounding and coming back a substep later.
+// A vertex or edge that would cross within the substep meets its plane first, however fast (no
+// tunnelling from a state without penetration). A vertex more than the gap behind a plane is taken
+// for the far side of a thin part and left alone. Self-contact leaves out the features that share
+// a corner and those within the gap of each other in the rest shape (not all the features around
+// a vertex: where a surface wrinkles under compression, its faces two apart are the ones that cross).
 void World::detectBodyContacts() {
   bodyContacts_.clear();
   std::vector<BodyId> taking;
-  int touching = 0;
+  int touchingBodies = 0;
   bool self = false;
   for (BodyId id = 0; id < bodies_.size(); ++id) {
     const BodyContactSettings& s = bodyContactSettings_[id];
     if (bodies_[id].state != BodyState::Active || bodies_[id].model->surface.empty() || !(s.bodies || s.self)) continue;
     taking.push_back(id);
-    touching += s.bodies;
+    touchingBodies += s.bodies;
     self |= s.self;
   }
-  if (taking.empty() || (!self && touching < 2)) return;
+  if (taking.empty() || (!self && touchingBodies < 2)) return;
 
-  const Point* const pred = predicted_.data();
-  const Point* const start = local_.data();
   const Body& reference = bodies_[taking.front()];
-  const auto sweptBox = [&](Index i, const Vec3& offset, float grow) {
-    Box3f box(start[i].pos + offset);
-    box.extend(pred[i].pos + offset);
-    return Box3f(box.min().array() - grow, box.max().array() + grow);
-  };
   contactTriangles_.clear();
   contactBoxes_.clear();
   double extent = 0.0;
   for (BodyId id : taking) {
     const Body& b = bodies_[id];
     const Vec3 offset = offsetBetween(b, reference);
-    const float grow = bodyContactSettings_[id].thickness;
+    const float grow = 2.0f * bodyContactSettings_[id].thickness;
     const std::vector<Triangle>& surface = b.model->surface;
     for (Index t = 0; t < surface.size(); ++t) {
       Box3f box = sweptBox(b.firstParticle + surface[t][0], offset, grow);
@@ -122,65 +129,143 @@ void World::detectBodyContacts() {
   // Cells the size of a typical triangle's box: a vertex's box meets a few cells, a triangle's a few.
   const float cell = std::max(float(extent / double(contactBoxes_.size())), 1e-6f);
   contactHash_.build(contactBoxes_, cell);
-  contactSeen_.assign(contactBoxes_.size(), std::numeric_limits<Index>::max());
-
+  contactSeen_.assign(contactBoxes_.size(), 0);
+  const ContactSurface& last = contactSurfaces_.back();
+  edgeSeen_.assign(last.firstEdgeKey + last.edges.size(), 0);
+  contactQuery_ = 0;
   for (BodyId a : taking) {
-    const Body& body = bodies_[a];
-    const BodyContactSettings& sa = bodyContactSettings_[a];
-    const ContactSurface& surfaceA = contactSurfaces_[a];
-    const Vec3 offsetA = offsetBetween(body, reference);
-    for (Index v : surfaceA.vertices) {
-      const Index i = body.firstParticle + v;
-      const Box3f box = sweptBox(i, offsetA, sa.thickness);
-      const std::size_t first = bodyContacts_.size();
-      const float vertexMotion = (pred[i].pos - start[i].pos).norm();
-      contactHash_.query(box, [&](Index item) {
-        if (contactSeen_[item] == i) return;
-        contactSeen_[item] = i;
-        const BodyId bId = contactTriangles_[item].body;
-        const BodyContactSettings& sb = bodyContactSettings_[bId];
-        if (a == bId ? !sa.self : !(sa.bodies && sb.bodies && pairContact(a, bId))) return;
-        if (!box.intersects(contactBoxes_[item])) return;
-        const Body& other = bodies_[bId];
-        const Triangle& tri = other.model->surface[contactTriangles_[item].triangle];
-        const float gap = sa.thickness + sb.thickness;
-        if (a == bId) {
-          const Index* const n = surfaceA.neighbours.data();
-          const auto near = [&](Index c) {
-            return c == v || std::binary_search(n + surfaceA.neighbourStart[v], n + surfaceA.neighbourStart[v + 1], c);
-          };
-          if (near(tri[0]) || near(tri[1]) || near(tri[2])) return;
-          const std::vector<Vec3>& rest = body.model->restPositions;
-          const std::array<float, 3> w = closestPointOnTriangle(rest[v], rest[tri[0]], rest[tri[1]], rest[tri[2]]);
-          if ((rest[v] - (w[0] * rest[tri[0]] + w[1] * rest[tri[1]] + w[2] * rest[tri[2]])).norm() <= gap) return;
-        }
-        const Index corner[3] = {other.firstParticle + tri[0], other.firstParticle + tri[1],
-                                 other.firstParticle + tri[2]};
-        if (pred[i].w == 0.0f && pred[corner[0]].w == 0.0f && pred[corner[1]].w == 0.0f && pred[corner[2]].w == 0.0f)
-          return;
-        const Vec3 offset = offsetBetween(other, body);
-        const std::optional<VertexTriangleTouch> touch =
-            touchVertexTriangle(start[i].pos, start[corner[0]].pos + offset, start[corner[1]].pos + offset,
-                                start[corner[2]].pos + offset, contactSurfaces_[bId].closed);
-        if (!touch) return;
-        float motion = vertexMotion;
-        for (Index c : corner) motion = std::max(motion, vertexMotion + (pred[c].pos - start[c].pos).norm());
-        if (!(touch->distance >= -gap && touch->distance <= gap + motion)) return;
-        bodyContacts_.push_back({i,
-                                 {corner[0], corner[1], corner[2]},
-                                 contactSurfaces_[bId].firstKey + contactTriangles_[item].triangle,
+    detectVertexTriangle(a);
+    detectEdgeEdge(a);
+  }
+  // The order the warm start matches contacts in.
+  std::sort(bodyContacts_.begin(), bodyContacts_.end(),
+            [](const BodyContact& x, const BodyContact& y) { return x.key < y.key; });
+}
+
+namespace {
+
+// Whether self-contact leaves the pair of features (corners of one body) out: they share a corner,
+// or they are within `gap` of each other in the rest shape (distanceAtRest), where the body is as
+// it should be.
+template <typename Distance>
+bool leftOut(std::span<const Index> f, std::span<const Index> g, float gap, Distance&& distanceAtRest) {
+  for (Index c : f)
+    if (std::find(g.begin(), g.end(), c) != g.end()) return true;
+  return distanceAtRest() <= gap;
+}
+
+}  // namespace
+
+void World::detectVertexTriangle(BodyId a) {
+  const Point* const pred = predicted_.data();
+  const Point* const start = local_.data();
+  const Body& body = bodies_[a];
+  const BodyContactSettings& sa = bodyContactSettings_[a];
+  const ContactSurface& surfaceA = contactSurfaces_[a];
+  const Vec3 offsetA = offsetBetween(body, bodies_[contactTriangles_.front().body]);
+  const std::vector<Vec3>& rest = body.model->restPositions;
+  for (Index v : surfaceA.vertices) {
+    const Index i = body.firstParticle + v;
+    const Box3f box = sweptBox(i, offsetA, 2.0f * sa.thickness);
+    const float motion = (pred[i].pos - start[i].pos).norm();
+    const std::uint32_t query = ++contactQuery_;
+    contactHash_.query(box, [&](Index item) {
+      if (contactSeen_[item] == query) return;
+      contactSeen_[item] = query;
+      const BodyId bId = contactTriangles_[item].body;
+      if (!touching(a, bId) || !box.intersects(contactBoxes_[item])) return;
+      const BodyContactSettings& sb = bodyContactSettings_[bId];
+      const Body& other = bodies_[bId];
+      const Index t = contactTriangles_[item].triangle;
+      const Triangle& tri = other.model->surface[t];
+      const float gap = sa.thickness + sb.thickness;
+      if (a == bId && leftOut(std::span(&v, 1), std::span(tri), gap, [&] {
+            const std::array<float, 3> w = closestPointOnTriangle(rest[v], rest[tri[0]], rest[tri[1]], rest[tri[2]]);
+            return (rest[v] - (w[0] * rest[tri[0]] + w[1] * rest[tri[1]] + w[2] * rest[tri[2]])).norm();
+          }))
+        return;
+      const std::array<Index, 4> p{i, other.firstParticle + tri[0], other.firstParticle + tri[1],
+                                   other.firstParticle + tri[2]};
+      if (pred[p[0]].w == 0.0f && pred[p[1]].w == 0.0f && pred[p[2]].w == 0.0f && pred[p[3]].w == 0.0f) return;
+      const Vec3 offset = offsetBetween(other, body);
+      const std::optional<VertexTriangleTouch> touch =
+          touchVertexTriangle(start[i].pos, start[p[1]].pos + offset, start[p[2]].pos + offset,
+                              start[p[3]].pos + offset, contactSurfaces_[bId].closed);
+      if (!touch) return;
+      float reach = 0.0f;
+      for (int k = 1; k < 4; ++k) reach = std::max(reach, (pred[p[k]].pos - start[p[k]].pos).norm());
+      if (!(touch->distance >= -gap && touch->distance <= 2.0f * gap + motion + reach)) return;
+      const std::uint64_t key = std::uint64_t(i) << 32 | (contactSurfaces_[bId].firstTriangleKey + t);
+      bodyContacts_.push_back({p,
+                               {1.0f, -touch->b[0], -touch->b[1], -touch->b[2]},
+                               1,
+                               key,
+                               offset,
+                               touch->normal,
+                               gap,
+                               sa.compliance + sb.compliance,
+                               std::sqrt(sa.staticFriction * sb.staticFriction),
+                               std::sqrt(sa.dynamicFriction * sb.dynamicFriction)});
+    });
+  }
+}
+
+// Each edge pair once: from the body with the lower id, within a body from the lower edge.
+void World::detectEdgeEdge(BodyId a) {
+  const Point* const pred = predicted_.data();
+  const Point* const start = local_.data();
+  const Body& body = bodies_[a];
+  const BodyContactSettings& sa = bodyContactSettings_[a];
+  const ContactSurface& surfaceA = contactSurfaces_[a];
+  const Vec3 offsetA = offsetBetween(body, bodies_[contactTriangles_.front().body]);
+  const std::vector<Vec3>& rest = body.model->restPositions;
+  for (Index e = 0; e < surfaceA.edges.size(); ++e) {
+    const std::array<Index, 2>& edge = surfaceA.edges[e];
+    const Index i0 = body.firstParticle + edge[0], i1 = body.firstParticle + edge[1];
+    const Box3f box = sweptBox(i0, offsetA, 2.0f * sa.thickness).extend(sweptBox(i1, offsetA, 2.0f * sa.thickness));
+    const float motion = std::max((pred[i0].pos - start[i0].pos).norm(), (pred[i1].pos - start[i1].pos).norm());
+    const std::uint32_t query = ++contactQuery_;
+    contactHash_.query(box, [&](Index item) {
+      if (contactSeen_[item] == query) return;
+      contactSeen_[item] = query;
+      const BodyId bId = contactTriangles_[item].body;
+      if (bId < a || !touching(a, bId) || !box.intersects(contactBoxes_[item])) return;
+      const BodyContactSettings& sb = bodyContactSettings_[bId];
+      const Body& other = bodies_[bId];
+      const ContactSurface& surfaceB = contactSurfaces_[bId];
+      const float gap = sa.thickness + sb.thickness;
+      const Vec3 offset = offsetBetween(other, body);
+      for (Index f : surfaceB.triangleEdges[contactTriangles_[item].triangle]) {
+        const Index fKey = surfaceB.firstEdgeKey + f;
+        if ((a == bId && f <= e) || edgeSeen_[fKey] == query) continue;
+        edgeSeen_[fKey] = query;
+        const std::array<Index, 2>& g = surfaceB.edges[f];
+        if (a == bId && leftOut(std::span(edge), std::span(g), gap, [&] {
+              const auto t = touchEdgeEdge(rest[edge[0]], rest[edge[1]], rest[g[0]], rest[g[1]]);
+              return t ? t->distance : std::numeric_limits<float>::infinity();
+            }))
+          continue;
+        const std::array<Index, 4> p{i0, i1, other.firstParticle + g[0], other.firstParticle + g[1]};
+        if (pred[p[0]].w == 0.0f && pred[p[1]].w == 0.0f && pred[p[2]].w == 0.0f && pred[p[3]].w == 0.0f) continue;
+        const std::optional<EdgeEdgeTouch> touch =
+            touchEdgeEdge(start[p[0]].pos, start[p[1]].pos, start[p[2]].pos + offset, start[p[3]].pos + offset);
+        if (!touch) continue;
+        const float reach =
+            std::max((pred[p[2]].pos - start[p[2]].pos).norm(), (pred[p[3]].pos - start[p[3]].pos).norm());
+        if (!(touch->distance <= 2.0f * gap + motion + reach)) continue;
+        const std::uint64_t key = 1ull << 63 | std::uint64_t(surfaceA.firstEdgeKey + e) << 32 | fKey;
+        bodyContacts_.push_back({p,
+                                 {1.0f - touch->s, touch->s, touch->t - 1.0f, -touch->t},
+                                 2,
+                                 key,
                                  offset,
                                  touch->normal,
-                                 touch->b,
                                  gap,
                                  sa.compliance + sb.compliance,
                                  std::sqrt(sa.staticFriction * sb.staticFriction),
                                  std::sqrt(sa.dynamicFriction * sb.dynamicFriction)});
-      });
-      // In particle order, then by triangle: the order the warm start matches contacts in.
-      std::sort(bodyContacts_.begin() + std::ptrdiff_t(first), bodyContacts_.end(),
-                [](const BodyContact& x, const BodyContact& y) { return x.triangle < y.triangle; });
-    }
+      }
+    });
   }
 }
 
@@ -190,33 +275,30 @@ void World::solveBodyContacts(float invH) {
   const Point* const start = local_.data();
   for (std::size_t c = 0; c < bodyContacts_.size(); ++c) {
     const BodyContact& con = bodyContacts_[c];
-    Point& p = pred[con.particle];
-    std::array<Point, 3> x;
-    std::array<Vec3, 3> x0;
-    for (std::size_t k = 0; k < 3; ++k) {
-      x[k] = {pred[con.corner[k]].pos + con.offset, pred[con.corner[k]].w};
-      x0[k] = start[con.corner[k]].pos + con.offset;
+    std::array<Point, 4> x;
+    std::array<Vec3, 4> x0;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Vec3 offset = k < con.firstCorners ? Vec3::Zero() : con.offset;
+      x[k] = {pred[con.particle[k]].pos + offset, pred[con.particle[k]].w};
+      x0[k] = start[con.particle[k]].pos + offset;
     }
-    const VertexTriangleCorrection r = solveVertexTriangleContact(
-        p, x, con, bodyContactLambda_[c], XpbdCoefficients::make(con.compliance, 0.0f, invH));
+    const BodyContactCorrection r =
+        solveBodyContact(x, con, bodyContactLambda_[c], XpbdCoefficients::make(con.compliance, 0.0f, invH));
     bodyContactLambda_[c] += r.dLambda;
-    p.pos += r.dp;
-    for (std::size_t k = 0; k < 3; ++k) x[k].pos += r.dx[k];
-    const Vec3 friction = vertexTriangleFriction(p, start[con.particle].pos, x, x0, con, bodyContactLambda_[c],
-                                                 bodyContactFrictionLambda_[c]);
+    for (std::size_t k = 0; k < 4; ++k) x[k].pos += r.dx[k];
+    const Vec3 friction = bodyContactFriction(x, x0, con, bodyContactLambda_[c], bodyContactFrictionLambda_[c]);
     bodyContactFrictionLambda_[c] += friction;
-    p.pos += p.w * friction;
-    for (std::size_t k = 0; k < 3; ++k)
-      pred[con.corner[k]].pos = x[k].pos - con.offset - (x[k].w * con.b[k]) * friction;
+    for (std::size_t k = 0; k < 4; ++k) pred[con.particle[k]].pos += r.dx[k] + (x[k].w * con.weight[k]) * friction;
   }
 }
 
 float World::deepestPenetration() const {
   float deepest = 0.0f;
   for (const BodyContact& con : bodyContacts_) {
-    Vec3 q = Vec3::Zero();
-    for (std::size_t k = 0; k < 3; ++k) q += con.b[k] * (local_[con.corner[k]].pos + con.offset);
-    deepest = std::max(deepest, -con.normal.dot(local_[con.particle].pos - q));
+    Vec3 d = Vec3::Zero();
+    for (std::size_t k = 0; k < 4; ++k)
+      d += con.weight[k] * (local_[con.particle[k]].pos + (k < con.firstCorners ? Vec3::Zero() : con.offset));
+    deepest = std::max(deepest, -con.normal.dot(d));
   }
   return deepest;
 }
@@ -228,9 +310,10 @@ Vec3 World::bodyContactForce(BodyId on, BodyId by) const {
   Vec3 sum = Vec3::Zero();
   for (std::size_t c = 0; c < bodyContacts_.size(); ++c) {
     const BodyContact& con = bodyContacts_[c];
+    const BodyId first = particleBody_[con.particle[0]], second = particleBody_[con.particle[3]];
     const Vec3 push = bodyContactLambda_[c] * con.normal + bodyContactFrictionLambda_[c];
-    if (particleBody_[con.particle] == on && particleBody_[con.corner[0]] == by) sum += push;
-    if (particleBody_[con.corner[0]] == on && particleBody_[con.particle] == by) sum -= push;
+    if (first == on && second == by) sum += push;
+    if (second == on && first == by) sum -= push;
   }
   return sum / (h * h);
 }

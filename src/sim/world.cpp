@@ -148,13 +148,12 @@ BodyId World::addBody(std::shared_ptr<const BodyModel> model, const Vec3& transl
     particleBody_.push_back(id);
   }
   bodies_.push_back(std::move(body));
-  ContactSurface surface;
-  for (const Triangle& t : model->surface) surface.vertices.insert(surface.vertices.end(), t.begin(), t.end());
-  std::sort(surface.vertices.begin(), surface.vertices.end());
-  surface.vertices.erase(std::unique(surface.vertices.begin(), surface.vertices.end()), surface.vertices.end());
-  surface.firstKey = id == 0 ? 0 : contactSurfaces_.back().firstKey + Index(bodies_[id - 1].model->surface.size());
-  surface.closed = !model->tets.empty();
-  contactSurfaces_.push_back(std::move(surface));
+  contactSurfaces_.push_back(contactSurfaceOf(*model));
+  if (id > 0) {
+    const ContactSurface& before = contactSurfaces_[id - 1];
+    contactSurfaces_[id].firstTriangleKey = before.firstTriangleKey + Index(bodies_[id - 1].model->surface.size());
+    contactSurfaces_[id].firstEdgeKey = before.firstEdgeKey + Index(before.edges.size());
+  }
   bodyContactSettings_.emplace_back();
   frameColliders();
   frameFingertips();
@@ -720,15 +719,18 @@ void World::resetMultipliers(const SolverTeam& team) {
 // Body contacts found again keep their multipliers and push as they did, along their contact
 // planes (fixed over a substep, so the inertial predictions' gradients are the solver's).
 void World::carryBodyContacts() {
-  const std::vector<std::size_t> same = sameContacts(previousBodyContacts_, bodyContacts_, &BodyContact::triangle);
+  std::vector<std::size_t> same(bodyContacts_.size(), std::string::npos);  // both lists sorted by key
+  for (std::size_t i = 0, j = 0; i < bodyContacts_.size(); ++i) {
+    while (j < previousBodyContacts_.size() && previousBodyContacts_[j].key < bodyContacts_[i].key) ++j;
+    if (j < previousBodyContacts_.size() && previousBodyContacts_[j].key == bodyContacts_[i].key) same[i] = j;
+  }
   carry(bodyContactLambda_, same, 0.0f);
   carry(bodyContactFrictionLambda_, same, Vec3(Vec3::Zero()));
   Point* const pred = predicted_.data();
   for (std::size_t c = 0; c < bodyContacts_.size(); ++c) {
     const BodyContact& con = bodyContacts_[c];
     const Vec3 push = bodyContactLambda_[c] * con.normal + bodyContactFrictionLambda_[c];
-    pred[con.particle].pos += pred[con.particle].w * push;
-    for (int k = 0; k < 3; ++k) pred[con.corner[k]].pos -= (pred[con.corner[k]].w * con.b[std::size_t(k)]) * push;
+    for (std::size_t k = 0; k < 4; ++k) pred[con.particle[k]].pos += (pred[con.particle[k]].w * con.weight[k]) * push;
   }
 }
 
@@ -1287,9 +1289,8 @@ std::vector<Vec3> World::particleConstraintForces(BodyId id) const {
   for (std::size_t c = 0; c < bodyContacts_.size(); ++c) {
     const BodyContact& con = bodyContacts_[c];
     const Vec3 push = (bodyContactLambda_[c] * con.normal + bodyContactFrictionLambda_[c]) * invH2;
-    if (Vec3* fi = local(con.particle)) *fi += push;
-    for (int k = 0; k < 3; ++k)
-      if (Vec3* fi = local(con.corner[k])) *fi -= con.b[std::size_t(k)] * push;
+    for (std::size_t k = 0; k < 4; ++k)
+      if (Vec3* fi = local(con.particle[k])) *fi += con.weight[k] * push;
   }
   return f;
 }

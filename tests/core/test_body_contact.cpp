@@ -57,48 +57,68 @@ TEST(VertexTriangleTouch, DegenerateTrianglesAndVerticesOnAnEdgeMakeNone) {
 }
 
 BodyContact contactOf(const VertexTriangleTouch& t, float gap, float mu = 0.0f) {
-  return {0, {1, 2, 3}, 0, Vec3::Zero(), t.normal, t.b, gap, 0.0f, mu, mu};
+  return {{0, 1, 2, 3}, {1.0f, -t.b[0], -t.b[1], -t.b[2]}, 1, 0, Vec3::Zero(), t.normal, gap, 0.0f, mu, mu};
 }
 
-TEST(VertexTriangleContact, OneProjectionRestoresTheGapAndConservesMomentum) {
+TEST(EdgeEdgeTouch, CrossedEdgesMeetAtTheirClosestPoints) {
+  // Edge along x at height 0.01 above an edge along z: closest points in their middles.
+  const auto t =
+      touchEdgeEdge(Vec3(-1.0f, 0.01f, 0.0f), Vec3(1.0f, 0.01f, 0.0f), Vec3(0.0f, 0.0f, -0.5f), Vec3(0.0f, 0.0f, 1.5f));
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(t->s, 0.5f, 1e-6f);
+  EXPECT_NEAR(t->t, 0.25f, 1e-6f);
+  EXPECT_NEAR(t->distance, 0.01f, 1e-6f);
+  EXPECT_NEAR((t->normal - Vec3::UnitY()).norm(), 0.0f, 1e-5f);
+  // Parallel edges, edges that meet, and closest points at an end make none.
+  EXPECT_FALSE(touchEdgeEdge(Vec3(0, 0.01f, 0), Vec3(1, 0.01f, 0), Vec3(0, 0, 0), Vec3(1, 0, 0)));
+  EXPECT_FALSE(touchEdgeEdge(Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, -1), Vec3(0, 0, 1)));
+  EXPECT_FALSE(touchEdgeEdge(Vec3(0.5f, 0.01f, 0), Vec3(2, 0.01f, 0), Vec3(0, 0, -1), Vec3(0, 0, 1)));
+}
+
+TEST(BodyContactProjection, OneProjectionRestoresTheGapAndConservesMomentum) {
   // The constraint is linear in the positions (a fixed plane), so one rigid projection solves it:
-  // C = 0 after, whatever the masses, and sum m dx = 0 since the gradients sum to n - sum b_k n = 0.
-  const std::array<Point, 3> x{Point{kA, 2.0f}, Point{kB, 0.5f}, Point{kC, 1.0f}};
-  const Point p{Vec3(0.3f, -0.004f, -0.2f), 4.0f};
-  const auto touch = touchVertexTriangle(p.pos, kA, kB, kC, true);
+  // C = 0 after, whatever the masses, and sum m dx = 0 since the weights sum to 1 - 1 = 0.
+  const std::array<Point, 4> x{Point{Vec3(0.3f, -0.004f, -0.2f), 4.0f}, Point{kA, 2.0f}, Point{kB, 0.5f},
+                               Point{kC, 1.0f}};
+  const auto touch = touchVertexTriangle(x[0].pos, kA, kB, kC, true);
   ASSERT_TRUE(touch);
   const BodyContact c = contactOf(*touch, 0.002f);
-  const VertexTriangleCorrection r = solveVertexTriangleContact(p, x, c, 0.0f, {0.0f, 0.0f});
+  const BodyContactCorrection r = solveBodyContact(x, c, 0.0f, {0.0f, 0.0f});
   EXPECT_GT(r.dLambda, 0.0f);
-  Vec3 q = Vec3::Zero(), momentum = r.dp / p.w;
-  for (std::size_t k = 0; k < 3; ++k) {
-    q += c.b[k] * (x[k].pos + r.dx[k]);
+  Vec3 d = Vec3::Zero(), momentum = Vec3::Zero();
+  for (std::size_t k = 0; k < 4; ++k) {
+    d += c.weight[k] * (x[k].pos + r.dx[k]);
     momentum += r.dx[k] / x[k].w;
   }
-  EXPECT_NEAR(c.normal.dot(p.pos + r.dp - q), 0.002f, 1e-7f);
+  EXPECT_NEAR(c.normal.dot(d), 0.002f, 1e-7f);
   EXPECT_NEAR(momentum.norm(), 0.0f, 1e-7f);
   // Separated beyond the gap with no multiplier: nothing.
-  const Point far{Vec3(0.3f, 0.01f, -0.2f), 4.0f};
-  EXPECT_EQ(solveVertexTriangleContact(far, x, c, 0.0f, {0.0f, 0.0f}).dLambda, 0.0f);
+  std::array<Point, 4> far = x;
+  far[0].pos.y() = 0.01f;
+  EXPECT_EQ(solveBodyContact(far, c, 0.0f, {0.0f, 0.0f}).dLambda, 0.0f);
   // A multiplier never goes negative: pulled apart, it returns what it had, no more.
-  const VertexTriangleCorrection back = solveVertexTriangleContact(far, x, c, 1e-4f, {0.0f, 0.0f});
-  EXPECT_FLOAT_EQ(back.dLambda, -1e-4f);
+  EXPECT_FLOAT_EQ(solveBodyContact(far, c, 1e-4f, {0.0f, 0.0f}).dLambda, -1e-4f);
+  // All kinematic: nothing moves.
+  std::array<Point, 4> fixed = x;
+  for (Point& p : fixed) p.w = 0.0f;
+  EXPECT_EQ(solveBodyContact(fixed, c, 0.0f, {0.0f, 0.0f}).dLambda, 0.0f);
 }
 
-TEST(VertexTriangleContact, FrictionSticksInsideTheConeAndSlidesOnItsEdge) {
-  const std::array<Point, 3> x{Point{kA, 1.0f}, Point{kB, 1.0f}, Point{kC, 1.0f}};
-  const std::array<Vec3, 3> x0{kA, kB, kC};
+TEST(BodyContactProjection, FrictionSticksInsideTheConeAndSlidesOnItsEdge) {
   const Vec3 p0(0.3f, 0.002f, -0.2f);
+  const std::array<Vec3, 4> x0{p0, kA, kB, kC};
+  const std::array<Point, 4> x{Point{p0 + Vec3(0.001f, 0.0f, 0.0f), 1.0f}, Point{kA, 1.0f}, Point{kB, 1.0f},
+                               Point{kC, 1.0f}};  // the vertex slid 1 mm along x
   const auto touch = touchVertexTriangle(p0, kA, kB, kC, true);
   ASSERT_TRUE(touch);
   const BodyContact c = contactOf(*touch, 0.002f, 0.5f);
-  const Point p{p0 + Vec3(0.001f, 0.0f, 0.0f), 1.0f};  // slid 1 mm along x
-  const float inverseMass = 1.0f + c.b[0] * c.b[0] + c.b[1] * c.b[1] + c.b[2] * c.b[2];
+  float inverseMass = 0.0f;
+  for (float w : c.weight) inverseMass += w * w;
   // lambda_n large: sticks, the relative tangential motion cancelled exactly.
-  const Vec3 stick = vertexTriangleFriction(p, p0, x, x0, c, 1.0f, Vec3::Zero());
+  const Vec3 stick = bodyContactFriction(x, x0, c, 1.0f, Vec3::Zero());
   EXPECT_NEAR((stick * inverseMass + Vec3(0.001f, 0.0f, 0.0f)).norm(), 0.0f, 1e-7f);  // a few ulp(0.3)
   // lambda_n small: slides, the friction multiplier on the dynamic cone mu_k lambda_n.
-  const Vec3 slide = vertexTriangleFriction(p, p0, x, x0, c, 1e-4f, Vec3::Zero());
+  const Vec3 slide = bodyContactFriction(x, x0, c, 1e-4f, Vec3::Zero());
   EXPECT_NEAR(slide.norm(), 0.5f * 1e-4f, 1e-9f);
   EXPECT_LT(slide.x(), 0.0f);
 }
@@ -112,7 +132,7 @@ TEST(SpatialHash, QueriesFindEveryOverlappingBox) {
     boxes.emplace_back(lo, lo + Vec3(size(rng), size(rng), size(rng)));
   }
   const float inf = std::numeric_limits<float>::infinity();
-  boxes.emplace_back(Vec3(-inf, 0.0f, 0.0f), Vec3(inf, 0.0f, 0.0f));     // unbounded: on the list
+  boxes.emplace_back(Vec3(-inf, 0.0f, 0.0f), Vec3(inf, 0.0f, 0.0f));      // unbounded: on the list
   boxes.emplace_back(Vec3(-5.0f, -5.0f, -5.0f), Vec3(5.0f, 5.0f, 5.0f));  // too many cells: on the list
   SpatialHash hash;
   hash.build(boxes, 0.1f);

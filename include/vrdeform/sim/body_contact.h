@@ -1,12 +1,14 @@
 #pragma once
 // Contact between bodies and of a body with itself (beyond the paper, whose bodies meet only
-// colliders and fingertips): a surface vertex against a surface triangle, as an inequality
-// constraint with a multiplier, Coulomb friction and a contact thickness. lambda/h^2 is the
+// colliders and fingertips): a surface vertex against a surface triangle, and a surface edge
+// against a surface edge where vertices alone would let thin parts pass, as inequality
+// constraints with a multiplier, Coulomb friction and a contact thickness. lambda/h^2 is the
 // normal force (N), so a finger that presses one body into another feels the second through the
 // first.
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <optional>
 
@@ -27,20 +29,23 @@ struct BodyContactSettings {
   float compliance = 0.0f;       ///< alpha of the contacts (m/N)
 };
 
-/// A surface vertex touching (or about to touch) a surface triangle in the current substep. The
-/// contact is linearised at the substep's start: the normal and the triangle's contact point
-/// (barycentric weights b) are fixed while the iterations run, as a contact plane.
+/// A point of one body's surface touching (or about to touch) a point of another's (or of its own
+/// surface elsewhere) in the current substep: a vertex against a triangle, or an edge against an
+/// edge. Each point is a weighted sum of its corners, so the contact's separation is
+/// d = sum_k c_k x_k with weights c_k summing to 1 over the first body's corners and to -1 over
+/// the other's. The contact is linearised at the substep's start: the normal and the weights are
+/// fixed while the iterations run, as a contact plane.
 struct BodyContact {
-  Index particle;           ///< the vertex (world particle index)
-  Index corner[3];          ///< the triangle's corners (world particle indices)
-  Index triangle;           ///< the triangle's key: its body's first key + its index in the body's surface
-  Vec3 offset;              ///< from the corners' body frame to the vertex's (0 within a body)
-  Vec3 normal;              ///< unit, from the triangle towards the vertex
-  std::array<float, 3> b;   ///< barycentric weights of the triangle's contact point
-  float gap;                ///< the distance kept: the two bodies' thicknesses
-  float compliance;         ///< the two bodies' compliances in series (m/N)
-  float staticFriction;     ///< mu_s of the pair
-  float dynamicFriction;    ///< mu_k of the pair
+  std::array<Index, 4> particle;  ///< world particle indices: the first body's corners, then the other's
+  std::array<float, 4> weight;    ///< c_k: a vertex {1, -b0, -b1, -b2}; an edge pair {1-s, s, -(1-t), -t}
+  std::uint32_t firstCorners;     ///< how many corners are the first body's: 1 (vertex) or 2 (edge)
+  std::uint64_t key;              ///< identifies the pair of features, for the warm start
+  Vec3 offset;                    ///< from the other body's frame to the first's (0 within a body)
+  Vec3 normal;                    ///< unit, from the other body's point towards the first's
+  float gap;                      ///< the distance kept: the two bodies' thicknesses
+  float compliance;               ///< the two bodies' compliances in series (m/N)
+  float staticFriction;           ///< mu_s of the pair
+  float dynamicFriction;          ///< mu_k of the pair
 };
 
 /// Where a vertex x meets triangle (a, b, c): the contact normal, the contact point's weights and
@@ -77,45 +82,67 @@ inline std::optional<VertexTriangleTouch> touchVertexTriangle(const Vec3& x, con
   return VertexTriangleTouch{d / length, w, length};
 }
 
-/// One projection of a vertex-triangle contact: dLambda and the moves of the vertex and corners.
-struct VertexTriangleCorrection {
+/// Where edge (p0, p1) meets edge (q0, q1) (one frame): the closest points p0 + s (p1 - p0) and
+/// q0 + t (q1 - q0) (Ericson, Real-Time Collision Detection, 5.1.9) and the unit normal between them,
+/// from the second edge to the first. Only where both are inside their edges (0 < s, t < 1): at an
+/// end it is a vertex near an edge or face, which the vertex-triangle contacts hold. Nothing for
+/// (nearly) parallel edges or edges that meet.
+struct EdgeEdgeTouch {
+  Vec3 normal;
+  float s, t;
+  float distance;
+};
+inline std::optional<EdgeEdgeTouch> touchEdgeEdge(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {
+  const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+  const float a = d1.squaredNorm(), e = d2.squaredNorm(), b = d1.dot(d2), c = d1.dot(r), f = d2.dot(r);
+  const float denominator = a * e - b * b;  // |d1 x d2|^2
+  if (!(denominator > 1e-6f * a * e)) return std::nullopt;
+  const float s = (b * f - c * e) / denominator, t = (b * s + f) / e;
+  if (!(s > 0.0f && s < 1.0f && t > 0.0f && t < 1.0f)) return std::nullopt;
+  const Vec3 d = p0 + s * d1 - (q0 + t * d2);
+  const float length = d.norm();
+  if (!(length > std::sqrt(std::numeric_limits<float>::epsilon() * std::max(a, e)))) return std::nullopt;
+  return EdgeEdgeTouch{d / length, s, t, length};
+}
+
+/// One projection of a body contact: dLambda and each corner's move.
+struct BodyContactCorrection {
   float dLambda = 0.0f;
-  Vec3 dp = Vec3::Zero();
-  std::array<Vec3, 3> dx{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  std::array<Vec3, 4> dx{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
 };
 
-/// C = n . (p - sum_k b_k x_k) - gap >= 0 with n and b fixed over the substep (the contact plane),
-/// so grad_p C = n and grad_{x_k} C = -b_k n exactly. Eq. 1 with the inequality clamp:
-/// dLambda = (-C - alphaTilde lambda) / (w_p + sum_k b_k^2 w_k + alphaTilde), lambda stays >= 0;
-/// eq. 3 moves the vertex by w_p n dLambda and corner k by -w_k b_k n dLambda. The corners are
-/// given in the vertex's frame. Nothing moves where nothing can (all kinematic).
-inline VertexTriangleCorrection solveVertexTriangleContact(const Point& p, const std::array<Point, 3>& x,
-                                                           const BodyContact& c, float lambda,
-                                                           const XpbdCoefficients& k) {
-  VertexTriangleCorrection out;
-  const Vec3 q = c.b[0] * x[0].pos + c.b[1] * x[1].pos + c.b[2] * x[2].pos;
-  const float C = c.normal.dot(p.pos - q) - c.gap;
-  if (C >= 0.0f && lambda <= 0.0f) return out;
-  const float inverseMass = p.w + c.b[0] * c.b[0] * x[0].w + c.b[1] * c.b[1] * x[1].w + c.b[2] * c.b[2] * x[2].w;
-  if (!(inverseMass > 0.0f)) return out;
+/// C = n . sum_k c_k x_k - gap >= 0 with n and c fixed over the substep (the contact plane), so
+/// grad_{x_k} C = c_k n exactly. Eq. 1 with the inequality clamp:
+/// dLambda = (-C - alphaTilde lambda) / (sum_k c_k^2 w_k + alphaTilde), lambda stays >= 0; eq. 3
+/// moves corner k by w_k c_k n dLambda. The corners are given in the first body's frame. Nothing
+/// moves where nothing can (all kinematic). Since the weights sum to 1 and -1 on the two sides,
+/// sum_k m_k dx_k = 0: the contact moves no momentum between the pair and the rest of the world.
+inline BodyContactCorrection solveBodyContact(const std::array<Point, 4>& x, const BodyContact& c, float lambda,
+                                              const XpbdCoefficients& k) {
+  BodyContactCorrection out;
+  Vec3 d = Vec3::Zero();
+  float inverseMass = 0.0f;
+  for (std::size_t j = 0; j < 4; ++j) {
+    d += c.weight[j] * x[j].pos;
+    inverseMass += c.weight[j] * c.weight[j] * x[j].w;
+  }
+  const float C = c.normal.dot(d) - c.gap;
+  if ((C >= 0.0f && lambda <= 0.0f) || !(inverseMass > 0.0f)) return out;
   out.dLambda = std::max(lambda + deltaLambda(C, lambda, inverseMass, k), 0.0f) - lambda;
-  out.dp = (p.w * out.dLambda) * c.normal;
-  for (int j = 0; j < 3; ++j) out.dx[std::size_t(j)] = (-x[std::size_t(j)].w * c.b[std::size_t(j)] * out.dLambda) * c.normal;
+  for (std::size_t j = 0; j < 4; ++j) out.dx[j] = (x[j].w * c.weight[j] * out.dLambda) * c.normal;
   return out;
 }
 
-/// Friction of a vertex-triangle contact pushing with lambdaNormal (frictionDelta): against the
-/// vertex's motion in the substep relative to the triangle's contact point (p - p0 - sum_k b_k
-/// (x_k - x0_k)), with the pair's inverse mass w_p + sum_k b_k^2 w_k. Returns the multiplier's
-/// change; the vertex moves by w_p times it and corner k by -w_k b_k times it.
-inline Vec3 vertexTriangleFriction(const Point& p, const Vec3& p0, const std::array<Point, 3>& x,
-                                   const std::array<Vec3, 3>& x0, const BodyContact& c, float lambdaNormal,
-                                   const Vec3& lambdaFriction) {
-  Vec3 motion = p.pos - p0;
-  float inverseMass = p.w;
-  for (std::size_t j = 0; j < 3; ++j) {
-    motion -= c.b[j] * (x[j].pos - x0[j]);
-    inverseMass += c.b[j] * c.b[j] * x[j].w;
+/// Friction of a body contact pushing with lambdaNormal (frictionDelta): against the contact
+/// points' relative motion in the substep, sum_k c_k (x_k - x0_k), with the pair's inverse mass
+/// sum_k c_k^2 w_k. Returns the multiplier's change; corner k moves by w_k c_k times it.
+inline Vec3 bodyContactFriction(const std::array<Point, 4>& x, const std::array<Vec3, 4>& x0, const BodyContact& c,
+                                float lambdaNormal, const Vec3& lambdaFriction) {
+  Vec3 motion = Vec3::Zero();
+  float inverseMass = 0.0f;
+  for (std::size_t j = 0; j < 4; ++j) {
+    motion += c.weight[j] * (x[j].pos - x0[j]);
+    inverseMass += c.weight[j] * c.weight[j] * x[j].w;
   }
   return frictionDelta(motion, c.normal, inverseMass, lambdaFriction, lambdaNormal, c.staticFriction,
                        c.dynamicFriction);

@@ -153,7 +153,7 @@ class World {
   /// Switches contact between two different bodies off (or back on); both must touch bodies too.
   void setPairContact(BodyId a, BodyId b, bool enabled);
   bool pairContact(BodyId a, BodyId b) const;
-  /// The last substep's body contacts, in particle order, and their normal multipliers (same order).
+  /// The last substep's body contacts (ordered by key) and their normal multipliers (same order).
   const std::vector<BodyContact>& bodyContacts() const { return bodyContacts_; }
   const std::vector<float>& bodyContactLambda() const { return bodyContactLambda_; }
   /// Total force the contacts between body `by`'s surface and body `on`'s applied to `on` in the
@@ -250,11 +250,11 @@ class World {
   std::vector<std::array<Vec3, 3>> fingertipTriangleImpulse_;  // per corner: sum of grad C dLambda this substep
   // Body contact: each body's settings and surface, the pairs switched off, the contacts.
   struct ContactSurface {
-    std::vector<Index> vertices;        // the surface's vertices (body-local, ascending)
-    std::vector<Index> neighbourStart;  // self-contact: particles sharing a tet (a cloth: a triangle)
-    std::vector<Index> neighbours;      //   with v, ascending, at neighbours[neighbourStart[v], [v + 1])
-    Index firstKey = 0;                 // the key (BodyContact::triangle) of its first triangle
-    bool closed = false;                // a soft body's boundary (outward); a cloth is two-sided
+    std::vector<Index> vertices;                      // the surface's vertices (body-local, ascending)
+    std::vector<std::array<Index, 2>> edges;          // its edges (body-local, lower first, ascending)
+    std::vector<std::array<Index, 3>> triangleEdges;  // each surface triangle's edges
+    Index firstTriangleKey = 0, firstEdgeKey = 0;     // world-wide numbers of its first triangle and edge
+    bool closed = false;                              // a soft body's boundary (outward); a cloth is two-sided
   };
   std::vector<BodyContactSettings> bodyContactSettings_;
   std::vector<ContactSurface> contactSurfaces_;
@@ -269,7 +269,13 @@ class World {
   };
   std::vector<ContactTriangle> contactTriangles_;  // the broad phase's items, and their swept boxes
   std::vector<Box3f> contactBoxes_;
-  std::vector<Index> contactSeen_;  // per item: the last vertex that met it
+  std::vector<std::uint32_t> contactSeen_, edgeSeen_;  // per item, per edge key: the last query that met it
+  std::uint32_t contactQuery_ = 0;
+  void detectVertexTriangle(BodyId a);
+  void detectEdgeEdge(BodyId a);
+  bool touching(BodyId a, BodyId b) const;  // the pair's settings let them touch
+  Box3f sweptBox(Index particle, const Vec3& offset, float grow) const;
+  static ContactSurface contactSurfaceOf(const BodyModel& model);
   // The last substep's contacts, whose multipliers a warm start carries over.
   std::vector<ColliderContact> previousColliderContacts_;
   std::vector<FingertipContact> previousFingertipContacts_;
