@@ -74,6 +74,9 @@ void printSummary(const RunSummary& r, const BuiltScene& scene) {
   for (const auto& [type, n] : r.constraints)
     if (n > 0) fmt::print(" {} {}", type, n);
   fmt::print("\n  volume loss: max {:.3f}%, final {:.3f}%\n", 100 * r.volumeLossMax, 100 * r.volumeLossFinal);
+  if (r.bodyContactsMax > 0)
+    fmt::print("  body contact: up to {} contacts pushing, deepest penetration {:.2f} mm\n", r.bodyContactsMax,
+               1e3 * r.penetrationMax);
   if (scene.spec.hand.enabled) {
     fmt::print("  force max (normalised, newtons):");
     for (int f = 0; f < kFingerCount; ++f)

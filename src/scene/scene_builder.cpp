@@ -121,6 +121,31 @@ PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log, const std::f
   return out;
 }
 
+// Lifts a placed body so that its lowest point sits the two bodies' thicknesses above the highest
+// particle of body `b.on` under its footprint (x and z), or above that body's top if none is under it.
+namespace {
+
+void placeOn(PlacedMesh& mesh, const BuiltScene& scene, const BodySpec& b) {
+  const SceneBody& below = scene.body(b.on);
+  const World& world = *scene.world;
+  const Eigen::AlignedBox3f footprint = boundsOf(mesh.tets.vertices);
+  float top = -std::numeric_limits<float>::infinity(), under = top;
+  const Body& lower = world.body(below.id);
+  for (Index i = lower.firstParticle; i < lower.firstParticle + lower.particleCount; ++i) {
+    const Vec3& p = world.particles().x[i].pos;
+    top = std::max(top, p.y());
+    if (p.x() >= footprint.min().x() && p.x() <= footprint.max().x() && p.z() >= footprint.min().z() &&
+        p.z() <= footprint.max().z())
+      under = std::max(under, p.y());
+  }
+  const float gap = world.bodyContact(below.id).thickness + b.contact.thickness;
+  const float lift = (std::isfinite(under) ? under : top) + gap - footprint.min().y();
+  for (std::vector<Vec3>* vs : {&mesh.tets.vertices, &mesh.surface.vertices, &mesh.render.vertices})
+    for (Vec3& v : *vs) v.y() += lift;
+}
+
+}  // namespace
+
 Eigen::AlignedBox3f bodyBounds(const World& world, BodyId id) {
   const Body& b = world.body(id);
   Eigen::AlignedBox3f box;
@@ -179,6 +204,7 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneBuildObserver& observer)
     body.kind = b.kind;
     try {
       body.mesh = placeBodyMesh(b, log, observer.stop);
+      if (!b.on.empty()) placeOn(body.mesh, scene, b);
       if (b.kind == BodyKind::Cloth) {
         body.model = makeCloth(body.mesh.surface, b.material);
       } else {
@@ -191,6 +217,7 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneBuildObserver& observer)
       throw Stopped(fmt::format("{} body '{}'", e.what(), b.name));
     }
     body.id = world.addBody(body.model);
+    world.setBodyContact(body.id, b.contact);
     const Vec3 wind = b.kind == BodyKind::Cloth ? spec.wind : Vec3::Zero();
     if (b.force != Vec3::Zero() || wind != Vec3::Zero()) world.setExternalForce(body.id, b.force, wind);
     if (!b.pin.empty()) {
@@ -213,6 +240,7 @@ BuiltScene buildScene(const SceneSpec& spec, const SceneBuildObserver& observer)
     scene.bodies.push_back(std::move(body));
   }
   for (const Collider& c : spec.colliders) world.addCollider(c);
+  for (const auto& [a, b] : spec.noContact) world.setPairContact(scene.body(a).id, scene.body(b).id, false);
 
   const double dt = spec.solver.timeStep;
   const long settleSteps = std::lround(spec.settle / dt), leastSteps = std::lround(0.5 / dt),

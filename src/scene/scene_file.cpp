@@ -516,12 +516,24 @@ std::vector<std::string> readPins(const Field& f) {
   return pins;
 }
 
+BodyContactSettings readBodyContact(const Table& t) {
+  t.allowOnly({"bodies", "self", "thickness", "static_friction", "dynamic_friction", "compliance"});
+  BodyContactSettings c;
+  t.readBool("bodies", c.bodies);
+  t.readBool("self", c.self);
+  t.readNumber("thickness", c.thickness, kNonNegative);
+  t.readNumber("static_friction", c.staticFriction, kNonNegative);
+  t.readNumber("dynamic_friction", c.dynamicFriction, kNonNegative);
+  t.readNumber("compliance", c.compliance, kNonNegative);
+  return c;
+}
+
 BodySpec readBody(const Table& t, std::size_t number) {
   static constexpr Option<BodyKind> kKinds[] = {{"soft", BodyKind::Soft}, {"cloth", BodyKind::Cloth}};
   static constexpr Option<Placement> kPlacements[] = {{"ground", Placement::Ground}, {"as_is", Placement::AsIs}};
   static constexpr Option<Mesher> kMeshers[] = {{"builtin", Mesher::Builtin}, {"tetgen", Mesher::TetGen}};
-  static const Keys kCommon = {"name",     "kind",      "mesh",  "scale",   "rotation",
-                               "position", "placement", "force", "material"};
+  static const Keys kCommon = {"name",      "kind",  "mesh",     "scale", "rotation", "position",
+                               "placement", "force", "material", "on",    "contact"};
   static const Keys kSoftOnly = {"render_mesh", "mesher", "tets", "max_volume", "constraints"};
   static const Keys kClothOnly = {"pin", "pin_tolerance"};
 
@@ -550,6 +562,8 @@ BodySpec readBody(const Table& t, std::size_t number) {
   t.readNumber("pin_tolerance", body.pinTolerance, kNonNegative);
   t.readVec3("force", body.force);
   body.material = readMaterial(t.table("material"), body.kind);
+  if (std::optional<Field> f = t.get("on")) body.on = f->name();
+  body.contact = readBodyContact(t.table("contact"));
   return body;
 }
 
@@ -726,7 +740,7 @@ OutputSpec readOutput(const Table& t) {
 
 SceneSpec readScene(const Table& root, std::string_view sourceName) {
   root.allowOnly({"format", "name", "description", "settle", "seconds", "wind", "ground", "solver", "body", "collider",
-                  "hand", "haptics", "output"});
+                  "no_contact", "hand", "haptics", "output"});
   if (std::optional<Field> f = root.get("format"); f && f->integer() != 1)
     f->fail(fmt::format("this vrdeform reads format 1, got {}", f->integer()));
 
@@ -750,7 +764,21 @@ SceneSpec readScene(const Table& root, std::string_view sourceName) {
     for (std::size_t i = 0; i < scene.bodies.size(); ++i)
       if (scene.bodies[i].name == body.name)
         t.fail("name", fmt::format("'{}' is also the name of body[{}]", printable(body.name), i + 1));
+    if (!body.on.empty() &&
+        std::none_of(scene.bodies.begin(), scene.bodies.end(), [&](const BodySpec& b) { return b.name == body.on; }))
+      t.fail("on", fmt::format("no body '{}' before this one", printable(body.on)));
     scene.bodies.push_back(std::move(body));
+  }
+  for (const Table& t : root.tables("no_contact")) {
+    t.allowOnly({"bodies"});
+    const std::vector<Field> names = t.require("bodies").elements("an array of two body names");
+    if (names.size() != 2) t.fail("bodies", fmt::format("needs two body names, got {}", names.size()));
+    std::array<std::string, 2> pair{names[0].name(), names[1].name()};
+    for (const std::string& name : pair)
+      if (std::none_of(scene.bodies.begin(), scene.bodies.end(), [&](const BodySpec& b) { return b.name == name; }))
+        t.fail("bodies", fmt::format("no body '{}'", printable(name)));
+    if (pair[0] == pair[1]) t.fail("bodies", "names one body twice (its self-contact is [body.contact] self)");
+    scene.noContact.push_back(std::move(pair));
   }
   for (const Table& t : root.tables("collider")) scene.colliders.push_back(readCollider(t));
   bool ground = true;  // a scene of a mesh alone stands on something

@@ -280,6 +280,8 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
         if (b.kind == BodyKind::Soft) loss = std::max(loss, std::abs(world.volumeLoss(b.id)));
       summary.volumeLossMax = std::max(summary.volumeLossMax, loss);
       summary.volumeLossFinal = loss;
+      summary.bodyContactsMax = std::max(summary.bodyContactsMax, world.lastStep().bodyContacts);
+      summary.penetrationMax = std::max(summary.penetrationMax, world.lastStep().deepestPenetration);
       summary.steps = k + 1;
 
       std::optional<HapticSample> sample;
@@ -366,6 +368,8 @@ std::string summaryJson(const RunSummary& s) {
   j["constraints"] = s.constraints;
   j["volume_loss_max"] = number(s.volumeLossMax);
   j["volume_loss_final"] = number(s.volumeLossFinal);
+  j["body_contacts_max"] = s.bodyContactsMax;
+  j["penetration_max_m"] = number(s.penetrationMax);
   json forceMax = json::object(), newtonsMax = json::object();
   for (int f = 0; f < kFingerCount; ++f)
     if (s.fingers[f]) {

@@ -58,15 +58,6 @@ World::ContactSurface World::contactSurfaceOf(const BodyModel& model) {
   };
   sortUnique(surface.vertices);
   sortUnique(surface.edges);
-  for (const Triangle& t : model.surface) {
-    std::array<Index, 3> e;
-    for (int k = 0; k < 3; ++k) {
-      const std::array<Index, 2> edge{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])};
-      e[std::size_t(k)] =
-          Index(std::lower_bound(surface.edges.begin(), surface.edges.end(), edge) - surface.edges.begin());
-    }
-    surface.triangleEdges.push_back(e);
-  }
   surface.closed = !model.tets.empty();
   return surface;
 }
@@ -108,35 +99,42 @@ void World::detectBodyContacts() {
   }
   if (taking.empty() || (!self && touchingBodies < 2)) return;
 
-  const Body& reference = bodies_[taking.front()];
-  contactTriangles_.clear();
-  contactBoxes_.clear();
-  double extent = 0.0;
+  broadPhases_.resize(bodies_.size());
+  std::size_t mostTriangles = 0, mostEdges = 0;
   for (BodyId id : taking) {
     const Body& b = bodies_[id];
-    const Vec3 offset = offsetBetween(b, reference);
+    ContactBroadPhase& broad = broadPhases_[id];
+    broad.offset = offsetBetween(b, bodies_[taking.front()]);
+    broad.boxes.clear();
+    broad.bounds.setEmpty();
     const float grow = 2.0f * bodyContactSettings_[id].thickness;
-    const std::vector<Triangle>& surface = b.model->surface;
-    for (Index t = 0; t < surface.size(); ++t) {
-      Box3f box = sweptBox(b.firstParticle + surface[t][0], offset, grow);
-      box.extend(sweptBox(b.firstParticle + surface[t][1], offset, grow));
-      box.extend(sweptBox(b.firstParticle + surface[t][2], offset, grow));
-      contactTriangles_.push_back({id, t});
-      contactBoxes_.push_back(box);
+    double extent = 0.0;
+    for (const Triangle& t : b.model->surface) {
+      Box3f box = sweptBox(b.firstParticle + t[0], broad.offset, grow);
+      box.extend(sweptBox(b.firstParticle + t[1], broad.offset, grow));
+      box.extend(sweptBox(b.firstParticle + t[2], broad.offset, grow));
+      broad.boxes.push_back(box);
+      broad.bounds.extend(box);
       if (const float size = box.sizes().maxCoeff(); std::isfinite(size)) extent += size;
     }
+    broad.edgeBoxes.clear();
+    for (const std::array<Index, 2>& e : contactSurfaces_[id].edges)
+      broad.edgeBoxes.push_back(sweptBox(b.firstParticle + e[0], broad.offset, grow)
+                                    .extend(sweptBox(b.firstParticle + e[1], broad.offset, grow)));
+    // Cells the size of a typical triangle's box: a vertex's box meets a few cells, a triangle's a few.
+    broad.hash.build(broad.boxes, std::max(float(extent / double(broad.boxes.size())), 1e-6f));
+    broad.edgeHash.build(broad.edgeBoxes, std::max(float(extent / double(broad.boxes.size())), 1e-6f));
+    mostTriangles = std::max(mostTriangles, b.model->surface.size());
+    mostEdges = std::max(mostEdges, contactSurfaces_[id].edges.size());
   }
-  // Cells the size of a typical triangle's box: a vertex's box meets a few cells, a triangle's a few.
-  const float cell = std::max(float(extent / double(contactBoxes_.size())), 1e-6f);
-  contactHash_.build(contactBoxes_, cell);
-  contactSeen_.assign(contactBoxes_.size(), 0);
-  const ContactSurface& last = contactSurfaces_.back();
-  edgeSeen_.assign(last.firstEdgeKey + last.edges.size(), 0);
+  seen_.assign(std::max(mostTriangles, mostEdges), 0);
   contactQuery_ = 0;
-  for (BodyId a : taking) {
-    detectVertexTriangle(a);
-    detectEdgeEdge(a);
-  }
+  for (BodyId a : taking)
+    for (BodyId b : taking) {
+      if (!touching(a, b) || !broadPhases_[a].bounds.intersects(broadPhases_[b].bounds)) continue;
+      detectVertexTriangle(a, b);
+      if (b >= a) detectEdgeEdge(a, b);
+    }
   // The order the warm start matches contacts in.
   std::sort(bodyContacts_.begin(), bodyContacts_.end(),
             [](const BodyContact& x, const BodyContact& y) { return x.key < y.key; });
@@ -156,29 +154,33 @@ bool leftOut(std::span<const Index> f, std::span<const Index> g, float gap, Dist
 
 }  // namespace
 
-void World::detectVertexTriangle(BodyId a) {
+void World::detectVertexTriangle(BodyId a, BodyId bId) {
   const Point* const pred = predicted_.data();
   const Point* const start = local_.data();
-  const Body& body = bodies_[a];
-  const BodyContactSettings& sa = bodyContactSettings_[a];
-  const ContactSurface& surfaceA = contactSurfaces_[a];
-  const Vec3 offsetA = offsetBetween(body, bodies_[contactTriangles_.front().body]);
+  const Body &body = bodies_[a], &other = bodies_[bId];
+  const BodyContactSettings &sa = bodyContactSettings_[a], &sb = bodyContactSettings_[bId];
+  const ContactSurface& surfaceB = contactSurfaces_[bId];
+  const ContactBroadPhase& broad = broadPhases_[bId];
+  const Vec3 offsetA = broadPhases_[a].offset, offset = offsetBetween(other, body);
   const std::vector<Vec3>& rest = body.model->restPositions;
-  for (Index v : surfaceA.vertices) {
+  const float gap = sa.thickness + sb.thickness;
+  const BodyContactSettings pair{true,
+                                 true,
+                                 gap,
+                                 std::sqrt(sa.staticFriction * sb.staticFriction),
+                                 std::sqrt(sa.dynamicFriction * sb.dynamicFriction),
+                                 sa.compliance + sb.compliance};
+  for (Index v : contactSurfaces_[a].vertices) {
     const Index i = body.firstParticle + v;
     const Box3f box = sweptBox(i, offsetA, 2.0f * sa.thickness);
+    if (!box.intersects(broad.bounds)) continue;
     const float motion = (pred[i].pos - start[i].pos).norm();
     const std::uint32_t query = ++contactQuery_;
-    contactHash_.query(box, [&](Index item) {
-      if (contactSeen_[item] == query) return;
-      contactSeen_[item] = query;
-      const BodyId bId = contactTriangles_[item].body;
-      if (!touching(a, bId) || !box.intersects(contactBoxes_[item])) return;
-      const BodyContactSettings& sb = bodyContactSettings_[bId];
-      const Body& other = bodies_[bId];
-      const Index t = contactTriangles_[item].triangle;
+    broad.hash.query(box, [&](Index t) {
+      if (seen_[t] == query) return;
+      seen_[t] = query;
+      if (!box.intersects(broad.boxes[t])) return;
       const Triangle& tri = other.model->surface[t];
-      const float gap = sa.thickness + sb.thickness;
       if (a == bId && leftOut(std::span(&v, 1), std::span(tri), gap, [&] {
             const std::array<float, 3> w = closestPointOnTriangle(rest[v], rest[tri[0]], rest[tri[1]], rest[tri[2]]);
             return (rest[v] - (w[0] * rest[tri[0]] + w[1] * rest[tri[1]] + w[2] * rest[tri[2]])).norm();
@@ -187,15 +189,13 @@ void World::detectVertexTriangle(BodyId a) {
       const std::array<Index, 4> p{i, other.firstParticle + tri[0], other.firstParticle + tri[1],
                                    other.firstParticle + tri[2]};
       if (pred[p[0]].w == 0.0f && pred[p[1]].w == 0.0f && pred[p[2]].w == 0.0f && pred[p[3]].w == 0.0f) return;
-      const Vec3 offset = offsetBetween(other, body);
-      const std::optional<VertexTriangleTouch> touch =
-          touchVertexTriangle(start[i].pos, start[p[1]].pos + offset, start[p[2]].pos + offset,
-                              start[p[3]].pos + offset, contactSurfaces_[bId].closed);
+      const std::optional<VertexTriangleTouch> touch = touchVertexTriangle(
+          start[i].pos, start[p[1]].pos + offset, start[p[2]].pos + offset, start[p[3]].pos + offset, surfaceB.closed);
       if (!touch) return;
       float reach = 0.0f;
       for (int k = 1; k < 4; ++k) reach = std::max(reach, (pred[p[k]].pos - start[p[k]].pos).norm());
       if (!(touch->distance >= -gap && touch->distance <= 2.0f * gap + motion + reach)) return;
-      const std::uint64_t key = std::uint64_t(i) << 32 | (contactSurfaces_[bId].firstTriangleKey + t);
+      const std::uint64_t key = std::uint64_t(i) << 32 | (surfaceB.firstTriangleKey + t);
       bodyContacts_.push_back({p,
                                {1.0f, -touch->b[0], -touch->b[1], -touch->b[2]},
                                1,
@@ -203,68 +203,67 @@ void World::detectVertexTriangle(BodyId a) {
                                offset,
                                touch->normal,
                                gap,
-                               sa.compliance + sb.compliance,
-                               std::sqrt(sa.staticFriction * sb.staticFriction),
-                               std::sqrt(sa.dynamicFriction * sb.dynamicFriction)});
+                               pair.compliance,
+                               pair.staticFriction,
+                               pair.dynamicFriction});
     });
   }
 }
 
-// Each edge pair once: from the body with the lower id, within a body from the lower edge.
-void World::detectEdgeEdge(BodyId a) {
+// Each edge pair once: from the body with the lower id (b >= a), within a body from the lower edge.
+void World::detectEdgeEdge(BodyId a, BodyId bId) {
   const Point* const pred = predicted_.data();
   const Point* const start = local_.data();
-  const Body& body = bodies_[a];
-  const BodyContactSettings& sa = bodyContactSettings_[a];
-  const ContactSurface& surfaceA = contactSurfaces_[a];
-  const Vec3 offsetA = offsetBetween(body, bodies_[contactTriangles_.front().body]);
+  const Body &body = bodies_[a], &other = bodies_[bId];
+  const BodyContactSettings &sa = bodyContactSettings_[a], &sb = bodyContactSettings_[bId];
+  const ContactSurface &surfaceA = contactSurfaces_[a], &surfaceB = contactSurfaces_[bId];
+  const ContactBroadPhase& broad = broadPhases_[bId];
+  const Vec3 offset = offsetBetween(other, body);
   const std::vector<Vec3>& rest = body.model->restPositions;
+  const float gap = sa.thickness + sb.thickness;
+  const BodyContactSettings pair{true,
+                                 true,
+                                 gap,
+                                 std::sqrt(sa.staticFriction * sb.staticFriction),
+                                 std::sqrt(sa.dynamicFriction * sb.dynamicFriction),
+                                 sa.compliance + sb.compliance};
   for (Index e = 0; e < surfaceA.edges.size(); ++e) {
     const std::array<Index, 2>& edge = surfaceA.edges[e];
     const Index i0 = body.firstParticle + edge[0], i1 = body.firstParticle + edge[1];
-    const Box3f box = sweptBox(i0, offsetA, 2.0f * sa.thickness).extend(sweptBox(i1, offsetA, 2.0f * sa.thickness));
+    const Box3f& box = broadPhases_[a].edgeBoxes[e];
+    if (!box.intersects(broad.bounds)) continue;
     const float motion = std::max((pred[i0].pos - start[i0].pos).norm(), (pred[i1].pos - start[i1].pos).norm());
     const std::uint32_t query = ++contactQuery_;
-    contactHash_.query(box, [&](Index item) {
-      if (contactSeen_[item] == query) return;
-      contactSeen_[item] = query;
-      const BodyId bId = contactTriangles_[item].body;
-      if (bId < a || !touching(a, bId) || !box.intersects(contactBoxes_[item])) return;
-      const BodyContactSettings& sb = bodyContactSettings_[bId];
-      const Body& other = bodies_[bId];
-      const ContactSurface& surfaceB = contactSurfaces_[bId];
-      const float gap = sa.thickness + sb.thickness;
-      const Vec3 offset = offsetBetween(other, body);
-      for (Index f : surfaceB.triangleEdges[contactTriangles_[item].triangle]) {
-        const Index fKey = surfaceB.firstEdgeKey + f;
-        if ((a == bId && f <= e) || edgeSeen_[fKey] == query) continue;
-        edgeSeen_[fKey] = query;
-        const std::array<Index, 2>& g = surfaceB.edges[f];
-        if (a == bId && leftOut(std::span(edge), std::span(g), gap, [&] {
-              const auto t = touchEdgeEdge(rest[edge[0]], rest[edge[1]], rest[g[0]], rest[g[1]]);
-              return t ? t->distance : std::numeric_limits<float>::infinity();
-            }))
-          continue;
-        const std::array<Index, 4> p{i0, i1, other.firstParticle + g[0], other.firstParticle + g[1]};
-        if (pred[p[0]].w == 0.0f && pred[p[1]].w == 0.0f && pred[p[2]].w == 0.0f && pred[p[3]].w == 0.0f) continue;
-        const std::optional<EdgeEdgeTouch> touch =
-            touchEdgeEdge(start[p[0]].pos, start[p[1]].pos, start[p[2]].pos + offset, start[p[3]].pos + offset);
-        if (!touch) continue;
-        const float reach =
-            std::max((pred[p[2]].pos - start[p[2]].pos).norm(), (pred[p[3]].pos - start[p[3]].pos).norm());
-        if (!(touch->distance <= 2.0f * gap + motion + reach)) continue;
-        const std::uint64_t key = 1ull << 63 | std::uint64_t(surfaceA.firstEdgeKey + e) << 32 | fKey;
-        bodyContacts_.push_back({p,
-                                 {1.0f - touch->s, touch->s, touch->t - 1.0f, -touch->t},
-                                 2,
-                                 key,
-                                 offset,
-                                 touch->normal,
-                                 gap,
-                                 sa.compliance + sb.compliance,
-                                 std::sqrt(sa.staticFriction * sb.staticFriction),
-                                 std::sqrt(sa.dynamicFriction * sb.dynamicFriction)});
-      }
+    broad.edgeHash.query(box, [&](Index f) {
+      if ((a == bId && f <= e) || seen_[f] == query) return;
+      seen_[f] = query;
+      if (!box.intersects(broad.edgeBoxes[f])) return;
+      const std::array<Index, 2>& g = surfaceB.edges[f];
+      if (a == bId && leftOut(std::span(edge), std::span(g), gap, [&] {
+            const auto touch = touchEdgeEdge(rest[edge[0]], rest[edge[1]], rest[g[0]], rest[g[1]]);
+            return touch ? touch->distance : std::numeric_limits<float>::infinity();
+          }))
+        return;
+      const std::array<Index, 4> p{i0, i1, other.firstParticle + g[0], other.firstParticle + g[1]};
+      if (pred[p[0]].w == 0.0f && pred[p[1]].w == 0.0f && pred[p[2]].w == 0.0f && pred[p[3]].w == 0.0f) return;
+      const std::optional<EdgeEdgeTouch> touch =
+          touchEdgeEdge(start[p[0]].pos, start[p[1]].pos, start[p[2]].pos + offset, start[p[3]].pos + offset);
+      if (!touch) return;
+      const float reach =
+          std::max((pred[p[2]].pos - start[p[2]].pos).norm(), (pred[p[3]].pos - start[p[3]].pos).norm());
+      if (!(touch->distance <= gap + motion + reach)) return;
+      const std::uint64_t key =
+          1ull << 63 | std::uint64_t(surfaceA.firstEdgeKey + e) << 32 | (surfaceB.firstEdgeKey + f);
+      bodyContacts_.push_back({p,
+                               {1.0f - touch->s, touch->s, touch->t - 1.0f, -touch->t},
+                               2,
+                               key,
+                               offset,
+                               touch->normal,
+                               gap,
+                               pair.compliance,
+                               pair.staticFriction,
+                               pair.dynamicFriction});
     });
   }
 }

@@ -698,7 +698,7 @@ TEST(SceneFile, GarbageAndInvalidUtf8AreSyntaxErrors) {
   // Control characters in a quoted key come back escaped.
   EXPECT_EQ(errorIn(std::string(kMinimal) + "\"a\\u0001\" = 1\n"),
             "scene.toml:3: body[1].a\\x01: unknown key (expected one of: name, kind, mesh, scale, rotation, position, "
-            "placement, force, material, render_mesh, mesher, tets, max_volume, constraints)");
+            "placement, force, material, on, contact, render_mesh, mesher, tets, max_volume, constraints)");
 
   std::mt19937 rng(7);
   for (int i = 0; i < 300; ++i) {

@@ -21,8 +21,10 @@ std::vector<std::string> names() {
   return n;
 }
 
-TEST(Scenes, ThePapersSixAreBuiltIn) {
-  EXPECT_EQ(names(), (std::vector<std::string>{"balloon", "bear", "flag", "furball", "jelly", "liver"}));
+// The paper's six, and three of bodies touching each other (docs/contact.md).
+TEST(Scenes, ThePapersSixAndTheContactScenesAreBuiltIn) {
+  EXPECT_EQ(names(), (std::vector<std::string>{"balloon", "bear", "drape", "flag", "furball", "jelly", "jelly_stack",
+                                               "liver", "liver_pad"}));
 }
 
 // The paper's tet counts (Table 1): the meshers land within 15% of them.
@@ -168,7 +170,8 @@ TEST_P(EveryPoke, NewtonsMatchAConvergedRun) {
   testing::record("converged_newtons", reference);
 }
 
-INSTANTIATE_TEST_SUITE_P(Builtin, EveryPoke, ::testing::Values("furball", "liver", "balloon", "jelly", "bear"));
+INSTANTIATE_TEST_SUITE_P(Builtin, EveryPoke,
+                         ::testing::Values("furball", "liver", "balloon", "jelly", "bear", "jelly_stack", "liver_pad"));
 
 // A poke on a scene a user writes, the mesh, its scale and the poke and nothing else: the liver's
 // mesh in millimetres under soft tissue, pressed 1.5 cm over a second. Frictionless (the paper's
@@ -273,10 +276,12 @@ TEST(Scenes, TheFlagWeighsAFlagsWeightAndMovesAsThePapersFlagDoes) {
   testing::record("paper_poke_newtons", rb.newtonsMax[index]);
 }
 
-INSTANTIATE_TEST_SUITE_P(Builtin, EveryBody, ::testing::Values("balloon", "bear", "furball", "jelly", "liver"));
+INSTANTIATE_TEST_SUITE_P(Builtin, EveryBody,
+                         ::testing::Values("balloon", "bear", "furball", "jelly", "liver", "jelly_stack", "liver_pad"));
 
 INSTANTIATE_TEST_SUITE_P(Builtin, EveryScene,
-                         ::testing::Values("balloon", "bear", "flag", "furball", "jelly", "liver"));
+                         ::testing::Values("balloon", "bear", "flag", "furball", "jelly", "liver", "drape",
+                                           "jelly_stack", "liver_pad"));
 
 TEST(SceneRun, WritesEveryOutputAndASummaryWithTheDocumentedKeys) {
   const testing::TempDir dir;
@@ -294,8 +299,9 @@ TEST(SceneRun, WritesEveryOutputAndASummaryWithTheDocumentedKeys) {
 
   std::ifstream in(settings.outDir / "summary.json");
   const nlohmann::json j = nlohmann::json::parse(in);
-  for (const char* key : {"scene", "steps", "dt", "tets", "particles", "constraints", "volume_loss_max",
-                          "volume_loss_final", "force_max", "stage_ms", "nan_events", "ok", "pokes"})
+  for (const char* key :
+       {"scene", "steps", "dt", "tets", "particles", "constraints", "volume_loss_max", "volume_loss_final",
+        "body_contacts_max", "penetration_max_m", "force_max", "stage_ms", "nan_events", "ok", "pokes"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_TRUE(j["pokes"].empty()) << "the poke was cut off at 2.5 s: no figures for half a press";
   EXPECT_GT(j["residuals"]["strain_volume"]["max"].get<double>(), 0.0);  // measured, and not converged at 8 x 5

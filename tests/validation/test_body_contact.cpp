@@ -15,7 +15,8 @@ namespace {
 
 constexpr float kG = 9.81f;
 
-std::shared_ptr<const BodyModel> block(const Vec3& size, int nx, int ny, int nz, float youngs, float density = 1000.0f) {
+std::shared_ptr<const BodyModel> block(const Vec3& size, int nx, int ny, int nz, float youngs,
+                                       float density = 1000.0f) {
   Material m;
   m.elastic = ElasticModuli{youngs, 0.3f, density};
   return makeSoftBody(makeBoxTets(Vec3::Zero(), size, nx, ny, nz), m, {false, true, true, false});
@@ -105,15 +106,18 @@ TEST(BodyContact, AHeadOnCollisionConservesMomentumAndGainsNoEnergy) {
   w.setBodyContact(a, frictionless);
   w.setBodyContact(b, frictionless);
   const auto bodyOf = [&](Index i) { return i < w.body(b).firstParticle ? a : b; };
-  for (std::size_t i = 0; i < w.particles().size(); ++i) w.particles().v[i] = Vec3(bodyOf(Index(i)) == a ? 1.0f : -1.0f, 0, 0);
+  for (std::size_t i = 0; i < w.particles().size(); ++i)
+    w.particles().v[i] = Vec3(bodyOf(Index(i)) == a ? 1.0f : -1.0f, 0, 0);
   const auto momentum = [&] {
     Vec3d p = Vec3d::Zero();
-    for (std::size_t i = 0; i < w.particles().size(); ++i) p += (w.particles().v[i] / w.particles().x[i].w).cast<double>();
+    for (std::size_t i = 0; i < w.particles().size(); ++i)
+      p += (w.particles().v[i] / w.particles().x[i].w).cast<double>();
     return p;
   };
   const auto kinetic = [&] {
     double e = 0.0;
-    for (std::size_t i = 0; i < w.particles().size(); ++i) e += 0.5 * w.particles().v[i].squaredNorm() / w.particles().x[i].w;
+    for (std::size_t i = 0; i < w.particles().size(); ++i)
+      e += 0.5 * w.particles().v[i].squaredNorm() / w.particles().x[i].w;
     return e;
   };
   const Vec3d p0 = momentum();
@@ -284,7 +288,8 @@ TEST(BodyContact, OverlappingAndHugeSpeedsGiveNoNanAndNoBlowUp) {
   const BodyId fast = w.addBody(model, Vec3(0.5f, 0.0f, 0.0f));
   (void)a;
   (void)b;
-  for (Index i = 0; i < w.body(fast).particleCount; ++i) w.particles().v[w.particleIndex(fast, i)] = Vec3(-1000.0f, 0, 0);
+  for (Index i = 0; i < w.body(fast).particleCount; ++i)
+    w.particles().v[w.particleIndex(fast, i)] = Vec3(-1000.0f, 0, 0);
   for (int step = 0; step < 30; ++step) {
     w.step();
     for (const Point& p : w.particles().x) ASSERT_TRUE(p.pos.allFinite() && p.pos.norm() < 1e3f) << "step " << step;

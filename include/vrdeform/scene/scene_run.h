@@ -66,6 +66,10 @@ struct RunSummary {
   std::map<std::string, std::size_t> constraints;  ///< count per type ("volume", "strain", ...)
   /// |v0 - v| / v0 (a gain counts as much as a loss), largest over the soft bodies
   double volumeLossMax = 0.0, volumeLossFinal = 0.0;
+  /// Contact between bodies and within them: the most contacts that pushed at a step's end, and the
+  /// deepest a vertex went past a surface it touches (m, StepReport::deepestPenetration).
+  std::size_t bodyContactsMax = 0;
+  float penetrationMax = 0.0f;
   std::array<bool, kFingerCount> fingers{};  ///< the hand's fingers
   std::array<float, kFingerCount> forceMax{}, newtonsMax{};
   float paperMax = 0.0f;

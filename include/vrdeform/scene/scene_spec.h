@@ -13,6 +13,7 @@
 #include "vrdeform/interact/hand_actions.h"
 #include "vrdeform/interact/hand_rig.h"
 #include "vrdeform/io/tetrahedralise.h"
+#include "vrdeform/sim/body_contact.h"
 #include "vrdeform/sim/body_model.h"
 #include "vrdeform/sim/collider.h"
 #include "vrdeform/sim/solver_settings.h"
@@ -41,6 +42,10 @@ struct BodySpec {
   std::vector<std::string> pin;
   float pinTolerance = 1e-3f;
   Vec3 force = Vec3::Zero();  ///< constant force on every particle (N); the scene's wind adds to cloth
+  /// Another (earlier) body this one is placed on: its lowest point the two thicknesses above the
+  /// highest point of that body under it (x and z as `placement` says). Empty: none.
+  std::string on;
+  BodyContactSettings contact;  ///< how it touches other bodies and itself
 };
 
 /// One scripted action of the hand (hand_actions.h) on a body, timed from the end of the settling
@@ -88,6 +93,9 @@ struct SceneSpec {
   double seconds = 6.0;                              ///< default length of a run after settling
   std::vector<BodySpec> bodies;
   std::vector<Collider> colliders;  ///< the ground is one, if wanted
+  /// Pairs of bodies (by name) that pass through each other; every other pair of bodies that
+  /// touch bodies touches.
+  std::vector<std::array<std::string, 2>> noContact;
   HandSpec hand;
   HapticsSpec haptics;
   OutputSpec output;

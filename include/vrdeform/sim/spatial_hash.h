@@ -51,6 +51,8 @@ class SpatialHash {
   std::vector<Index> start_;  // the items of slot s: items_[start_[s], start_[s + 1])
   std::vector<Index> items_;
   std::vector<Index> oversized_;
+  std::vector<Index> fill_;  // build's scratch
+  std::vector<Cells> cells_;
 };
 
 }  // namespace vrd

@@ -250,11 +250,10 @@ class World {
   std::vector<std::array<Vec3, 3>> fingertipTriangleImpulse_;  // per corner: sum of grad C dLambda this substep
   // Body contact: each body's settings and surface, the pairs switched off, the contacts.
   struct ContactSurface {
-    std::vector<Index> vertices;                      // the surface's vertices (body-local, ascending)
-    std::vector<std::array<Index, 2>> edges;          // its edges (body-local, lower first, ascending)
-    std::vector<std::array<Index, 3>> triangleEdges;  // each surface triangle's edges
-    Index firstTriangleKey = 0, firstEdgeKey = 0;     // world-wide numbers of its first triangle and edge
-    bool closed = false;                              // a soft body's boundary (outward); a cloth is two-sided
+    std::vector<Index> vertices;                   // the surface's vertices (body-local, ascending)
+    std::vector<std::array<Index, 2>> edges;       // its edges (body-local, lower first, ascending)
+    Index firstTriangleKey = 0, firstEdgeKey = 0;  // world-wide numbers of its first triangle and edge
+    bool closed = false;                           // a soft body's boundary (outward); a cloth is two-sided
   };
   std::vector<BodyContactSettings> bodyContactSettings_;
   std::vector<ContactSurface> contactSurfaces_;
@@ -262,18 +261,22 @@ class World {
   std::vector<BodyContact> bodyContacts_;
   std::vector<float> bodyContactLambda_;
   std::vector<Vec3> bodyContactFrictionLambda_;
-  SpatialHash contactHash_;
-  struct ContactTriangle {
-    BodyId body;
-    Index triangle;  // in the body's surface
+  // The broad phase of each body that takes part: its surface triangles' swept boxes in the frame
+  // of the first such body, their bounds, and a spatial hash of them.
+  struct ContactBroadPhase {
+    std::vector<Box3f> boxes;      // per surface triangle
+    std::vector<Box3f> edgeBoxes;  // per surface edge
+    Box3f bounds;
+    Vec3 offset;           // the body's frame to the common one
+    SpatialHash hash;      // of the triangles
+    SpatialHash edgeHash;  // of the edges
   };
-  std::vector<ContactTriangle> contactTriangles_;  // the broad phase's items, and their swept boxes
-  std::vector<Box3f> contactBoxes_;
-  std::vector<std::uint32_t> contactSeen_, edgeSeen_;  // per item, per edge key: the last query that met it
+  std::vector<ContactBroadPhase> broadPhases_;  // per body
+  std::vector<std::uint32_t> seen_;             // per triangle or edge of a body: the last query that met it
   std::uint32_t contactQuery_ = 0;
-  void detectVertexTriangle(BodyId a);
-  void detectEdgeEdge(BodyId a);
-  bool touching(BodyId a, BodyId b) const;  // the pair's settings let them touch
+  void detectVertexTriangle(BodyId a, BodyId b);  // a's vertices against b's triangles
+  void detectEdgeEdge(BodyId a, BodyId b);        // a's edges against b's
+  bool touching(BodyId a, BodyId b) const;        // the pair's settings let them touch
   Box3f sweptBox(Index particle, const Vec3& offset, float grow) const;
   static ContactSurface contactSurfaceOf(const BodyModel& model);
   // The last substep's contacts, whose multipliers a warm start carries over.
