@@ -144,12 +144,28 @@ void bindWorld(py::module_& m) {
       .def_readwrite("dynamic_friction", &Collider::dynamicFriction)
       .def_readwrite("compliance", &Collider::compliance);
 
+  py::class_<BodyContactSettings>(m, "BodyContactSettings", "How a body touches other bodies and itself")
+      .def(py::init([](bool bodies, bool self, float thickness, float staticFriction, float dynamicFriction,
+                       float compliance) {
+             return BodyContactSettings{bodies, self, thickness, staticFriction, dynamicFriction, compliance};
+           }),
+           py::arg("bodies") = true, py::arg("self") = false, py::arg("thickness") = 0.001f,
+           py::arg("static_friction") = 0.5f, py::arg("dynamic_friction") = 0.4f, py::arg("compliance") = 0.0f)
+      .def_readwrite("bodies", &BodyContactSettings::bodies)
+      .def_readwrite("self", &BodyContactSettings::self)
+      .def_readwrite("thickness", &BodyContactSettings::thickness)
+      .def_readwrite("static_friction", &BodyContactSettings::staticFriction)
+      .def_readwrite("dynamic_friction", &BodyContactSettings::dynamicFriction)
+      .def_readwrite("compliance", &BodyContactSettings::compliance);
+
   py::class_<StepReport>(m, "StepReport", "What the last step did")
       .def_readonly("step", &StepReport::step)
       .def_readonly("iterations", &StepReport::iterations)
       .def_readonly("cold_substeps", &StepReport::coldSubsteps)
       .def_readonly("collider_contacts", &StepReport::colliderContacts)
       .def_readonly("fingertip_contacts", &StepReport::fingertipContacts)
+      .def_readonly("body_contacts", &StepReport::bodyContacts)
+      .def_readonly("deepest_penetration", &StepReport::deepestPenetration)
       .def_property_readonly(
           "times_ms", [](const StepReport& r) { return stageDict(r.times.ms); },
           "milliseconds per stage, summed over the substeps")
@@ -314,6 +330,12 @@ to add bodies; write through set_positions and set_velocities.)")
       .def("fingertip_force", &World::fingertipForce, py::arg("fingertip"),
            "Force the fingertip applied to the bodies in the last substep (N)")
       .def("fingertip_contact_count", &World::fingertipContactCount, py::arg("fingertip"))
+      .def("set_body_contact", &World::setBodyContact, py::arg("body"), py::arg("settings"))
+      .def("body_contact", &World::bodyContact, py::arg("body"))
+      .def("set_pair_contact", &World::setPairContact, py::arg("a"), py::arg("b"), py::arg("enabled"),
+           "Switches contact between two different bodies off (or back on)")
+      .def("body_contact_force", &World::bodyContactForce, py::arg("on"), py::arg("by"),
+           "Force body `by`'s contacts applied to body `on` in the last substep (N)")
       .def("attach", &World::attach, py::arg("particle"), py::arg("target"), py::arg("compliance") = 0.0f,
            py::arg("axes") = Vec3(Vec3::Ones()), py::arg("damping") = 0.0f,
            "Holds a particle (world index) at target; returns the attachment's id")

@@ -170,3 +170,34 @@ def test_step_report_and_residuals(cube):
     assert r.step == 0 and r.iterations == s.iterations * s.substeps
     assert "strain_volume" in r.residuals and all(np.isfinite(v).all() for v in r.residuals.values())
     assert set(r.times_ms) >= {"predict", "finalise"}
+
+
+def test_bodies_touch_each_other_and_the_contact_carries_the_weight(cube):
+    s = vrdeform.SolverSettings()
+    s.substeps = 8
+    s.iterations = 10
+    s.warm_start = True
+    s.linear_damping = 5.0
+    w = vrdeform.World(s)
+    lower = w.add_soft_body(cube, soft_material())
+    upper = w.add_soft_body(cube, soft_material(), translation=(0.0, 0.0125, 0.0))
+    w.add_collider(vrdeform.Collider.plane())
+    settings = w.body_contact(upper)
+    assert settings.bodies and not settings.self and settings.thickness == pytest.approx(0.001)
+    settings.static_friction = 0.8
+    w.set_body_contact(upper, settings)
+    assert w.body_contact(upper).static_friction == pytest.approx(0.8)
+    for _ in range(90):
+        w.step()
+    weight = 1000.0 * 1e-6 * 9.81  # a 1 cm cube of 1000 kg/m^3
+    assert w.last_step.body_contacts > 0
+    assert w.last_step.deepest_penetration <= 0.001
+    assert w.body_contact_force(upper, lower)[1] == pytest.approx(weight, rel=0.05)
+    assert w.positions(upper)[:, 1].min() > w.positions(lower)[:, 1].max()
+    with pytest.raises(vrdeform.Error, match="thickness"):
+        w.set_body_contact(upper, vrdeform.BodyContactSettings(thickness=-1.0))
+    # Switched off, the pair passes through each other: the upper cube falls into the lower.
+    w.set_pair_contact(lower, upper, False)
+    for _ in range(30):
+        w.step()
+    assert w.positions(upper)[:, 1].min() < w.positions(lower)[:, 1].max()

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "test_support.h"
+#include "vrdeform/scene/scene_builder.h"
 #include "vrdeform/scene/scene_file.h"
 
 namespace vrd {
@@ -739,6 +740,81 @@ TEST(SceneFile, EditedScenesParseOrFailWithAnError) {
     }
   }
   EXPECT_GT(failures, 0);
+}
+
+}  // namespace
+}  // namespace vrd
+
+namespace vrd {
+namespace {
+
+// Contact between bodies in a scene file: each body's [body.contact], a body placed `on` another,
+// and pairs that pass through each other; a body `on` one that comes later, or a pair naming a
+// body the scene lacks, is an error at its key.
+TEST(SceneFile, ContactBetweenBodiesIsReadAndBuilt) {
+  const SceneSpec s = parse(R"([[body]]
+name = "pad"
+mesh = "sphere_coarse.obj"
+scale = 0.05
+[body.contact]
+self = true
+thickness = 0.002
+static_friction = 0.9
+dynamic_friction = 0.7
+[[body]]
+name = "top"
+mesh = "sphere_coarse.obj"
+scale = 0.03
+on = "pad"
+[[body]]
+name = "ghost"
+mesh = "sphere_coarse.obj"
+scale = 0.03
+position = [0.2, 0, 0]
+[body.contact]
+bodies = false
+[[no_contact]]
+bodies = ["top", "ghost"]
+)");
+  ASSERT_EQ(s.bodies.size(), 3u);
+  EXPECT_TRUE(s.bodies[0].contact.self);
+  EXPECT_FLOAT_EQ(s.bodies[0].contact.thickness, 0.002f);
+  EXPECT_FLOAT_EQ(s.bodies[0].contact.staticFriction, 0.9f);
+  EXPECT_FALSE(s.bodies[1].contact.self);  // the defaults
+  EXPECT_TRUE(s.bodies[1].contact.bodies);
+  EXPECT_FALSE(s.bodies[2].contact.bodies);
+  EXPECT_EQ(s.bodies[1].on, "pad");
+  ASSERT_EQ(s.noContact.size(), 1u);
+  EXPECT_EQ(s.noContact[0], (std::array<std::string, 2>{"top", "ghost"}));
+
+  SceneSpec quick = s;
+  quick.settle = 0.0;
+  quick.haptics.calibrate = false;
+  const BuiltScene scene = buildScene(quick);
+  const World& w = *scene.world;
+  EXPECT_TRUE(w.bodyContact(scene.body("pad").id).self);
+  EXPECT_FALSE(w.bodyContact(scene.body("ghost").id).bodies);
+  EXPECT_FALSE(w.pairContact(scene.body("top").id, scene.body("ghost").id));
+  EXPECT_TRUE(w.pairContact(scene.body("pad").id, scene.body("top").id));
+  // On the pad: the top's lowest point the two thicknesses above the pad's highest (0.002 + 0.001).
+  float padTop = -1e9f, topBottom = 1e9f;
+  for (Index i = 0; i < w.body(scene.body("pad").id).particleCount; ++i)
+    padTop = std::max(padTop, w.particles().x[w.particleIndex(scene.body("pad").id, i)].pos.y());
+  for (Index i = 0; i < w.body(scene.body("top").id).particleCount; ++i)
+    topBottom = std::min(topBottom, w.particles().x[w.particleIndex(scene.body("top").id, i)].pos.y());
+  EXPECT_NEAR(topBottom - padTop, 0.003f, 1e-5f);
+
+  EXPECT_EQ(
+      errorIn(std::string(kMinimal) + "on = \"later\"\n[[body]]\nname = \"later\"\nmesh = \"sphere_coarse.obj\"\n"),
+      "scene.toml:3: body[1].on: no body 'later' before this one");
+  EXPECT_EQ(errorIn(std::string(kMinimal) + "[[no_contact]]\nbodies = [\"body1\", \"nobody\"]\n"),
+            "scene.toml:4: no_contact[1].bodies: no body 'nobody'");
+  EXPECT_EQ(errorIn(std::string(kMinimal) + "[[no_contact]]\nbodies = [\"body1\"]\n"),
+            "scene.toml:4: no_contact[1].bodies: needs two body names, got 1");
+  EXPECT_EQ(errorIn(std::string(kMinimal) + "[body.contact]\nthickness = -1\n"),
+            "scene.toml:4: body[1].contact.thickness: must be >= 0, got -1");
+  EXPECT_EQ(errorIn(std::string(kMinimal) + "[body.contact]\nselff = true\n"),
+            "scene.toml:4: body[1].contact.selff: unknown key (did you mean 'self'?)");
 }
 
 }  // namespace

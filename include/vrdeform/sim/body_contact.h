@@ -56,12 +56,17 @@ struct VertexTriangleTouch {
   float distance;  ///< normal . (x - q): negative once x is past the triangle
 };
 
+/// On a closed surface, how far above a triangle's plane (as a share of its distance) a vertex
+/// beside an edge must be to touch it: one level with the plane, beside a neighbouring face of a
+/// flat part of the surface, touches nothing (about 6 degrees).
+inline constexpr float kSideOfPlane = 0.1f;
+
 /// The contact plane of vertex x and triangle (a, b, c) (all in one frame), from the closest point
 /// q of the triangle (closestPointOnTriangle). Where q is inside the face, the normal is the face
 /// normal: the outward one for a closed surface (a soft body's boundary, so a vertex found just
 /// inside is pushed back out), else the side x is on (a cloth is two-sided). Where q is on an edge
 /// or a corner the normal is (x - q)/|x - q|; on a closed surface only if x is on the triangle's
-/// outer side, since inside it another triangle is the one it crossed. Nothing for a degenerate
+/// outer side (kSideOfPlane), since inside it another triangle is the one it crossed. Nothing for a degenerate
 /// triangle (zero area to 32 eps relative) or x on an edge.
 inline std::optional<VertexTriangleTouch> touchVertexTriangle(const Vec3& x, const Vec3& a, const Vec3& b,
                                                               const Vec3& c, bool closed) {
@@ -78,7 +83,7 @@ inline std::optional<VertexTriangleTouch> touchVertexTriangle(const Vec3& x, con
   }
   const float length = d.norm();
   if (!(length > std::sqrt(std::numeric_limits<float>::epsilon() * longestSq))) return std::nullopt;
-  if (closed && face.dot(d) <= 0.0f) return std::nullopt;
+  if (closed && !(face.dot(d) > kSideOfPlane * length)) return std::nullopt;
   return VertexTriangleTouch{d / length, w, length};
 }
 

@@ -1,0 +1,84 @@
+// Body contact benchmarks (Google Benchmark), each with its baseline in the same run:
+//  - SelfContact/tets/self: a 10 x 10 x 20 cm block of {1k, 10k, 100k} tets pinned at one end and
+//    sagging (the paper's constraint set, 5 iterations, 1 substep), self-contact off (the baseline)
+//    and on. Counters: the surface's triangles, and the detection and body-contact solve times per
+//    step (StepReport stage times), so that detection's growth with the surface shows in one table.
+//  - Stack/tets: two such blocks, one resting on the other, contact between them on and off.
+
+#include <benchmark/benchmark.h>
+
+#include "vrdeform/mesh/primitives.h"
+#include "vrdeform/sim/world.h"
+
+namespace vrd {
+namespace {
+
+Material benchMaterial() {
+  Material m;
+  m.elastic = ElasticModuli{2e4f, 0.4f, 1000.0f, 0.001f};
+  return m;
+}
+
+std::shared_ptr<const BodyModel> block(int tets) {
+  return makeSoftBody(makeBoxTetsNear(Vec3::Zero(), Vec3(0.1f, 0.1f, 0.2f), tets), benchMaterial());
+}
+
+void pinEnd(World& world, BodyId body) {
+  const BodyModel& m = *world.body(body).model;
+  for (Index i = 0; i < m.particleCount(); ++i)
+    if (m.restPositions[i].z() < 1e-6f) world.setInverseMass(world.particleIndex(body, i), 0.0f);
+}
+
+// Steps the world, then reports the detection and body-contact stage times per step as counters.
+void timeSteps(benchmark::State& state, World& world, std::size_t triangles) {
+  for (int s = 0; s < 10; ++s) world.step();
+  double detect = 0.0, solve = 0.0;
+  std::size_t contacts = 0;
+  for (auto _ : state) {
+    world.step();
+    detect += world.lastStep().times.ms[std::size_t(Stage::Detect)];
+    solve += world.lastStep().times.ms[std::size_t(Stage::BodyContact)];
+    contacts += world.bodyContacts().size();
+  }
+  const double n = double(state.iterations());
+  state.counters["surface_triangles"] = double(triangles);
+  state.counters["detect_ms"] = detect / n;
+  state.counters["contact_solve_ms"] = solve / n;
+  state.counters["contacts"] = double(contacts) / n;
+}
+
+void SelfContact(benchmark::State& state) {
+  SolverSettings settings;
+  settings.timeStages = true;
+  World world(settings);
+  const auto model = block(int(state.range(0)));
+  const BodyId body = world.addBody(model);
+  pinEnd(world, body);
+  BodyContactSettings contact;
+  contact.self = state.range(1) != 0;
+  world.setBodyContact(body, contact);
+  timeSteps(state, world, model->surface.size());
+}
+BENCHMARK(SelfContact)
+    ->ArgNames({"tets", "self"})
+    ->ArgsProduct({{1000, 10000, 100000}, {0, 1}})
+    ->Unit(benchmark::kMillisecond);
+
+void Stack(benchmark::State& state) {
+  SolverSettings settings;
+  settings.timeStages = true;
+  World world(settings);
+  const auto model = block(int(state.range(0)));
+  const BodyId lower = world.addBody(model);
+  const BodyId upper = world.addBody(model, Vec3(0.0f, 0.101f, 0.0f));
+  pinEnd(world, lower);
+  world.addCollider(Collider::plane(Vec3::UnitY()));
+  world.setPairContact(lower, upper, state.range(1) != 0);
+  timeSteps(state, world, 2 * model->surface.size());
+}
+BENCHMARK(Stack)->ArgNames({"tets", "contact"})->ArgsProduct({{1000, 10000}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace vrd
+
+BENCHMARK_MAIN();
