@@ -87,17 +87,14 @@ Box3f World::sweptBox(Index i, const Vec3& offset, float grow) const {
 // a vertex: where a surface wrinkles under compression, its faces two apart are the ones that cross).
 void World::detectBodyContacts() {
   bodyContacts_.clear();
-  std::vector<BodyId> taking;
-  int touchingBodies = 0;
-  bool self = false;
-  for (BodyId id = 0; id < bodies_.size(); ++id) {
-    const BodyContactSettings& s = bodyContactSettings_[id];
-    if (bodies_[id].state != BodyState::Active || bodies_[id].model->surface.empty() || !(s.bodies || s.self)) continue;
-    taking.push_back(id);
-    touchingBodies += s.bodies;
-    self |= s.self;
-  }
-  if (taking.empty() || (!self && touchingBodies < 2)) return;
+  // The bodies that touch something: themselves, or another active body with a surface.
+  std::vector<BodyId> candidates, taking;
+  for (BodyId id = 0; id < bodies_.size(); ++id)
+    if (bodies_[id].state == BodyState::Active && !bodies_[id].model->surface.empty()) candidates.push_back(id);
+  for (BodyId a : candidates)
+    if (std::any_of(candidates.begin(), candidates.end(), [&](BodyId b) { return touching(a, b); }))
+      taking.push_back(a);
+  if (taking.empty()) return;
 
   broadPhases_.resize(bodies_.size());
   std::size_t mostTriangles = 0, mostEdges = 0;
@@ -142,14 +139,9 @@ void World::detectBodyContacts() {
 
 namespace {
 
-// Whether self-contact leaves the pair of features (corners of one body) out: they share a corner,
-// or they are within `gap` of each other in the rest shape (distanceAtRest), where the body is as
-// it should be.
-template <typename Distance>
-bool leftOut(std::span<const Index> f, std::span<const Index> g, float gap, Distance&& distanceAtRest) {
-  for (Index c : f)
-    if (std::find(g.begin(), g.end(), c) != g.end()) return true;
-  return distanceAtRest() <= gap;
+// Whether two features of one body share a corner: self-contact leaves them out.
+bool shareCorner(std::span<const Index> f, std::span<const Index> g) {
+  return std::any_of(f.begin(), f.end(), [&](Index c) { return std::find(g.begin(), g.end(), c) != g.end(); });
 }
 
 }  // namespace
@@ -181,11 +173,7 @@ void World::detectVertexTriangle(BodyId a, BodyId bId) {
       seen_[t] = query;
       if (!box.intersects(broad.boxes[t])) return;
       const Triangle& tri = other.model->surface[t];
-      if (a == bId && leftOut(std::span(&v, 1), std::span(tri), gap, [&] {
-            const std::array<float, 3> w = closestPointOnTriangle(rest[v], rest[tri[0]], rest[tri[1]], rest[tri[2]]);
-            return (rest[v] - (w[0] * rest[tri[0]] + w[1] * rest[tri[1]] + w[2] * rest[tri[2]])).norm();
-          }))
-        return;
+      if (a == bId && shareCorner(std::span(&v, 1), std::span(tri))) return;
       const std::array<Index, 4> p{i, other.firstParticle + tri[0], other.firstParticle + tri[1],
                                    other.firstParticle + tri[2]};
       if (pred[p[0]].w == 0.0f && pred[p[1]].w == 0.0f && pred[p[2]].w == 0.0f && pred[p[3]].w == 0.0f) return;
@@ -195,6 +183,10 @@ void World::detectVertexTriangle(BodyId a, BodyId bId) {
       float reach = 0.0f;
       for (int k = 1; k < 4; ++k) reach = std::max(reach, (pred[p[k]].pos - start[p[k]].pos).norm());
       if (!(touch->distance >= -gap && touch->distance <= 2.0f * gap + motion + reach)) return;
+      if (a == bId) {  // within the gap at rest: as the body should be
+        const std::array<float, 3> w = closestPointOnTriangle(rest[v], rest[tri[0]], rest[tri[1]], rest[tri[2]]);
+        if ((rest[v] - (w[0] * rest[tri[0]] + w[1] * rest[tri[1]] + w[2] * rest[tri[2]])).norm() <= gap) return;
+      }
       const std::uint64_t key = std::uint64_t(i) << 32 | (surfaceB.firstTriangleKey + t);
       bodyContacts_.push_back({p,
                                {1.0f, -touch->b[0], -touch->b[1], -touch->b[2]},
@@ -239,11 +231,7 @@ void World::detectEdgeEdge(BodyId a, BodyId bId) {
       seen_[f] = query;
       if (!box.intersects(broad.edgeBoxes[f])) return;
       const std::array<Index, 2>& g = surfaceB.edges[f];
-      if (a == bId && leftOut(std::span(edge), std::span(g), gap, [&] {
-            const auto touch = touchEdgeEdge(rest[edge[0]], rest[edge[1]], rest[g[0]], rest[g[1]]);
-            return touch ? touch->distance : std::numeric_limits<float>::infinity();
-          }))
-        return;
+      if (a == bId && shareCorner(std::span(edge), std::span(g))) return;
       const std::array<Index, 4> p{i0, i1, other.firstParticle + g[0], other.firstParticle + g[1]};
       if (pred[p[0]].w == 0.0f && pred[p[1]].w == 0.0f && pred[p[2]].w == 0.0f && pred[p[3]].w == 0.0f) return;
       const std::optional<EdgeEdgeTouch> touch =
@@ -252,6 +240,10 @@ void World::detectEdgeEdge(BodyId a, BodyId bId) {
       const float reach =
           std::max((pred[p[2]].pos - start[p[2]].pos).norm(), (pred[p[3]].pos - start[p[3]].pos).norm());
       if (!(touch->distance <= gap + motion + reach)) return;
+      if (a == bId) {  // within the gap at rest: as the body should be
+        const auto t = touchEdgeEdge(rest[edge[0]], rest[edge[1]], rest[g[0]], rest[g[1]]);
+        if (t && t->distance <= gap) return;
+      }
       const std::uint64_t key =
           1ull << 63 | std::uint64_t(surfaceA.firstEdgeKey + e) << 32 | (surfaceB.firstEdgeKey + f);
       bodyContacts_.push_back({p,
