@@ -529,6 +529,7 @@ TEST(TeamChoice, FollowsTheMachinesLoad) {
 TEST(Lanes, ThreadsGiveTheOneThreadResultExactlyWithContacts) {
   const auto model = dampedBlock(10, {true, true, true, true});
   ASSERT_EQ(model->tetGroups.size(), 6u);
+  std::size_t bodyContacts = 0;
   const auto run = [&](int threads, std::size_t& contacts) {
     SolverSettings s;
     s.threads = threads;
@@ -548,10 +549,16 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactlyWithContacts) {
     w.addCollider(Collider::sphere(Vec3(0.2f, 0.0f, 0.1f), 0.05f));  // the cloth drapes over it
     w.addBody(makeCloth(makeGridCloth(Vec3(0.1f, 0.051f, 0.0f), Vec3(0.2f, 0.0f, 0.0f), Vec3(0.0f, 0.0f, 0.2f), 20, 20),
                         cloth));
+    // A second block half on the first (body contact, and self-contact on the first), clear of the fingertips.
+    w.addBody(dampedBlock(2, {false, true, true, false}), Vec3(-0.07f, 0.1025f, -0.07f), Quat::Identity());
+    BodyContactSettings self;
+    self.self = true;
+    w.setBodyContact(b, self);
     contacts = 0;
     for (int step = 0; step < 5; ++step) {
       w.step();
-      contacts += w.lastStep().colliderContacts + w.lastStep().fingertipContacts;
+      contacts += w.lastStep().colliderContacts + w.lastStep().fingertipContacts + w.lastStep().bodyContacts;
+      bodyContacts += w.lastStep().bodyContacts;
     }
     std::vector<Vec3> x;
     for (const Point& p : w.particles().x) x.push_back(p.pos);
@@ -560,6 +567,7 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactlyWithContacts) {
   std::size_t contacts = 0;
   const std::vector<Vec3> one = run(1, contacts);
   EXPECT_GT(contacts, 5 * 121u + 100u);  // the block's bottom layer in every step, and the cloth on the sphere
+  EXPECT_GT(bodyContacts, 0u);
   for (int threads : {2, 3}) {
     std::size_t same = 0;
     const std::vector<Vec3> many = run(threads, same);
