@@ -7,21 +7,13 @@
 
 #include <benchmark/benchmark.h>
 
-#include "vrdeform/mesh/primitives.h"
+#include "bench_block.h"
 #include "vrdeform/sim/world.h"
 
 namespace vrd {
 namespace {
 
-Material benchMaterial() {
-  Material m;
-  m.elastic = ElasticModuli{2e4f, 0.4f, 1000.0f, 0.001f};
-  return m;
-}
-
-std::shared_ptr<const BodyModel> block(int tets) {
-  return makeSoftBody(makeBoxTetsNear(Vec3::Zero(), Vec3(0.1f, 0.1f, 0.2f), tets), benchMaterial());
-}
+std::shared_ptr<const BodyModel> block(int tets) { return makeSoftBody(benchBlock(tets), benchMaterial()); }
 
 void pinEnd(World& world, BodyId body) {
   const BodyModel& m = *world.body(body).model;

@@ -17,20 +17,12 @@
 #include <algorithm>
 #include <random>
 
+#include "bench_block.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/world.h"
 
 namespace vrd {
 namespace {
-
-Material benchMaterial() {
-  Material m;
-  m.elastic = ElasticModuli{2e4f, 0.4f, 1000.0f, 0.001f};
-  return m;
-}
-
-// A 10 cm x 10 cm x 20 cm block of about `tets` tets.
-TetMesh block(int tets) { return makeBoxTetsNear(Vec3::Zero(), Vec3(0.1f, 0.1f, 0.2f), tets); }
 
 void runSteps(benchmark::State& state, const TetMesh& mesh, const ConstraintSet& set, int iterations, SimdLevel simd,
               int threads = 1) {
@@ -63,7 +55,8 @@ void runSteps(benchmark::State& state, const TetMesh& mesh, const ConstraintSet&
 
 void Step(benchmark::State& state) {
   const ConstraintSet set = state.range(2) == 0 ? ConstraintSet::edgesAndVolume() : ConstraintSet::paper();
-  runSteps(state, block(int(state.range(0))), set, int(state.range(1)), SimdLevel(state.range(3)), int(state.range(4)));
+  runSteps(state, benchBlock(int(state.range(0))), set, int(state.range(1)), SimdLevel(state.range(3)),
+           int(state.range(4)));
 }
 BENCHMARK(Step)
     ->ArgNames({"tets", "iterations", "paper_set", "simd", "threads"})

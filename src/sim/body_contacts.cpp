@@ -150,21 +150,16 @@ void World::detectVertexTriangle(BodyId a, BodyId bId) {
   const Point* const pred = predicted_.data();
   const Point* const start = local_.data();
   const Body &body = bodies_[a], &other = bodies_[bId];
-  const BodyContactSettings &sa = bodyContactSettings_[a], &sb = bodyContactSettings_[bId];
+  const float thicknessA = bodyContactSettings_[a].thickness;
   const ContactSurface& surfaceB = contactSurfaces_[bId];
   const ContactBroadPhase& broad = broadPhases_[bId];
   const Vec3 offsetA = broadPhases_[a].offset, offset = offsetBetween(other, body);
   const std::vector<Vec3>& rest = body.model->restPositions;
-  const float gap = sa.thickness + sb.thickness;
-  const BodyContactSettings pair{true,
-                                 true,
-                                 gap,
-                                 std::sqrt(sa.staticFriction * sb.staticFriction),
-                                 std::sqrt(sa.dynamicFriction * sb.dynamicFriction),
-                                 sa.compliance + sb.compliance};
+  const ContactPair pair = contactPair(bodyContactSettings_[a], bodyContactSettings_[bId]);
+  const float gap = pair.gap;
   for (Index v : contactSurfaces_[a].vertices) {
     const Index i = body.firstParticle + v;
-    const Box3f box = sweptBox(i, offsetA, 2.0f * sa.thickness);
+    const Box3f box = sweptBox(i, offsetA, 2.0f * thicknessA);
     if (!box.intersects(broad.bounds)) continue;
     const float motion = (pred[i].pos - start[i].pos).norm();
     const std::uint32_t query = ++contactQuery_;
@@ -207,18 +202,12 @@ void World::detectEdgeEdge(BodyId a, BodyId bId) {
   const Point* const pred = predicted_.data();
   const Point* const start = local_.data();
   const Body &body = bodies_[a], &other = bodies_[bId];
-  const BodyContactSettings &sa = bodyContactSettings_[a], &sb = bodyContactSettings_[bId];
   const ContactSurface &surfaceA = contactSurfaces_[a], &surfaceB = contactSurfaces_[bId];
   const ContactBroadPhase& broad = broadPhases_[bId];
   const Vec3 offset = offsetBetween(other, body);
   const std::vector<Vec3>& rest = body.model->restPositions;
-  const float gap = sa.thickness + sb.thickness;
-  const BodyContactSettings pair{true,
-                                 true,
-                                 gap,
-                                 std::sqrt(sa.staticFriction * sb.staticFriction),
-                                 std::sqrt(sa.dynamicFriction * sb.dynamicFriction),
-                                 sa.compliance + sb.compliance};
+  const ContactPair pair = contactPair(bodyContactSettings_[a], bodyContactSettings_[bId]);
+  const float gap = pair.gap;
   for (Index e = 0; e < surfaceA.edges.size(); ++e) {
     const std::array<Index, 2>& edge = surfaceA.edges[e];
     const Index i0 = body.firstParticle + edge[0], i1 = body.firstParticle + edge[1];

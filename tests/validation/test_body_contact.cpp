@@ -43,6 +43,16 @@ TriMesh surfaces(const World& w, std::initializer_list<BodyId> ids) {
   return out;
 }
 
+// 8 substeps x 10 iterations, warm-started and damped: what the stacking tests settle with.
+SolverSettings restingSettings() {
+  SolverSettings s;
+  s.substeps = 8;
+  s.iterations = 10;
+  s.linearDamping = 5.0f;
+  s.warmStart = true;
+  return s;
+}
+
 bool crossing(const TriMesh& mesh) {
   SurfaceCheckOptions o;
   o.requireClosed = false;
@@ -56,12 +66,7 @@ bool crossing(const TriMesh& mesh) {
 // iterations leave each substep a different split of it between the contacts, which keeps the
 // blocks trembling at a few mm/s (40 cold iterations: 0.2 mm/s; warm: 0.01 mm/s).
 TEST(BodyContact, AStackComesToRestWithTheUpperWeightCarried) {
-  SolverSettings s;
-  s.substeps = 8;
-  s.iterations = 10;
-  s.linearDamping = 5.0f;
-  s.warmStart = true;
-  World w(s);
+  World w(restingSettings());
   const BodyId lower = w.addBody(block(Vec3(0.1f, 0.1f, 0.1f), 4, 4, 4, 5e4f), Vec3(-0.05f, 0.0f, -0.05f));
   const BodyId upper = w.addBody(block(Vec3(0.08f, 0.08f, 0.08f), 3, 3, 3, 5e4f), Vec3(-0.04f, 0.103f, -0.04f));
   w.addCollider(Collider::plane(Vec3::UnitY()));
@@ -252,12 +257,7 @@ namespace {
 // fingertip's push plus its weight equals what the lower block pushes back with (5%: the
 // multipliers of a warm-started run at rest).
 TEST(BodyContact, AFingertipPressingOneBodyIntoAnotherFeelsTheOther) {
-  SolverSettings s;
-  s.substeps = 8;
-  s.iterations = 10;
-  s.linearDamping = 5.0f;
-  s.warmStart = true;
-  World w(s);
+  World w(restingSettings());
   const BodyId pad = w.addBody(block(Vec3(0.1f, 0.04f, 0.1f), 4, 2, 4, 2e4f), Vec3(-0.05f, 0.0f, -0.05f));
   const BodyId top = w.addBody(block(Vec3(0.06f, 0.03f, 0.06f), 2, 2, 2, 2e5f), Vec3(-0.03f, 0.0425f, -0.03f));
   w.addCollider(Collider::plane(Vec3::UnitY()));

@@ -29,6 +29,16 @@ struct BodyContactSettings {
   float compliance = 0.0f;       ///< alpha of the contacts (m/N)
 };
 
+/// What the contacts between two bodies (or of one with itself) use: the distance kept (the two
+/// thicknesses), the compliance (the two in series) and the frictions (the geometric means).
+struct ContactPair {
+  float gap, compliance, staticFriction, dynamicFriction;
+};
+inline ContactPair contactPair(const BodyContactSettings& a, const BodyContactSettings& b) {
+  return {a.thickness + b.thickness, a.compliance + b.compliance, std::sqrt(a.staticFriction * b.staticFriction),
+          std::sqrt(a.dynamicFriction * b.dynamicFriction)};
+}
+
 /// A point of one body's surface touching (or about to touch) a point of another's (or of its own
 /// surface elsewhere) in the current substep: a vertex against a triangle, or an edge against an
 /// edge. Each point is a weighted sum of its corners, so the contact's separation is
