@@ -73,10 +73,10 @@ Box3f World::sweptBox(Index i, const Vec3& offset, float grow) const {
   return Box3f(box.min().array() - grow, box.max().array() + grow);
 }
 
-// Each substep, from the positions at its start and the predictions, through a spatial hash of
-// the surface triangles' swept boxes (start to prediction, grown by twice their body's thickness):
-// every surface vertex, and every surface edge, whose swept box meets a triangle's is a candidate
-// against it (an edge: against its edges), and becomes a contact where its contact plane
+// Each substep, from the positions at its start and the predictions, through spatial hashes of
+// each body's surface triangles and edges by their swept boxes (start to prediction, grown by
+// twice the body's thickness): a surface vertex whose swept box meets a triangle's, or an edge
+// whose box meets an edge's, is a candidate against it, and becomes a contact where its contact plane
 // (touchVertexTriangle, touchEdgeEdge, at the substep's start) is within twice the gap plus the
 // pair's motion in the substep. The second gap is a skin: a vertex resting on a surface stays in
 // the set instead of leaving it whenever it lifts by a rounding and coming back a substep later.

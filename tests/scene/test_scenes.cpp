@@ -170,8 +170,8 @@ TEST_P(EveryPoke, NewtonsMatchAConvergedRun) {
   testing::record("converged_newtons", reference);
 }
 
-INSTANTIATE_TEST_SUITE_P(Builtin, EveryPoke,
-                         ::testing::Values("furball", "liver", "balloon", "jelly", "bear", "jelly_stack", "liver_pad"));
+INSTANTIATE_TEST_SUITE_P(Builtin, EveryPoke, ::testing::Values("furball", "liver", "balloon", "jelly", "bear"));
+INSTANTIATE_TEST_SUITE_P(Contact, EveryPoke, ::testing::Values("jelly_stack", "liver_pad"));
 
 // A poke on a scene a user writes, the mesh, its scale and the poke and nothing else: the liver's
 // mesh in millimetres under soft tissue, pressed 1.5 cm over a second. Frictionless (the paper's
@@ -276,12 +276,14 @@ TEST(Scenes, TheFlagWeighsAFlagsWeightAndMovesAsThePapersFlagDoes) {
   testing::record("paper_poke_newtons", rb.newtonsMax[index]);
 }
 
-INSTANTIATE_TEST_SUITE_P(Builtin, EveryBody,
-                         ::testing::Values("balloon", "bear", "furball", "jelly", "liver", "jelly_stack", "liver_pad"));
+INSTANTIATE_TEST_SUITE_P(Builtin, EveryBody, ::testing::Values("balloon", "bear", "furball", "jelly", "liver"));
+INSTANTIATE_TEST_SUITE_P(Contact, EveryBody, ::testing::Values("jelly_stack", "liver_pad"));
 
 INSTANTIATE_TEST_SUITE_P(Builtin, EveryScene,
-                         ::testing::Values("balloon", "bear", "flag", "furball", "jelly", "liver", "drape",
-                                           "jelly_stack", "liver_pad"));
+                         ::testing::Values("balloon", "bear", "flag", "furball", "jelly", "liver"));
+// The scenes of bodies touching bodies (docs/contact.md): labelled long, as their detection makes
+// them slow under the sanitizers and the emulator.
+INSTANTIATE_TEST_SUITE_P(Contact, EveryScene, ::testing::Values("drape", "jelly_stack", "liver_pad"));
 
 TEST(SceneRun, WritesEveryOutputAndASummaryWithTheDocumentedKeys) {
   const testing::TempDir dir;

@@ -197,6 +197,10 @@ class World {
                               std::vector<FingertipContact>& fingertipContacts) const;
   void detectTriangleContacts();
   void detectBodyContacts();
+  void detectVertexTriangle(BodyId a, BodyId b);                         // a's vertices against b's triangles
+  void detectEdgeEdge(BodyId a, BodyId b);                               // a's edges against b's
+  bool touching(BodyId a, BodyId b) const;                               // the pair's settings let them touch
+  Box3f sweptBox(Index particle, const Vec3& offset, float grow) const;  // start to prediction, grown
   void solveBodyContacts(float invH);
   void carryBodyContacts();  // warm start: carries their multipliers over and pushes by them
   float deepestPenetration() const;
@@ -255,14 +259,15 @@ class World {
     Index firstTriangleKey = 0, firstEdgeKey = 0;  // world-wide numbers of its first triangle and edge
     bool closed = false;                           // a soft body's boundary (outward); a cloth is two-sided
   };
+  static ContactSurface contactSurfaceOf(const BodyModel& model);
   std::vector<BodyContactSettings> bodyContactSettings_;
   std::vector<ContactSurface> contactSurfaces_;
   std::vector<std::pair<BodyId, BodyId>> pairsOff_;  // (lower, higher), sorted
   std::vector<BodyContact> bodyContacts_;
   std::vector<float> bodyContactLambda_;
   std::vector<Vec3> bodyContactFrictionLambda_;
-  // The broad phase of each body that takes part: its surface triangles' swept boxes in the frame
-  // of the first such body, their bounds, and a spatial hash of them.
+  // The broad phase of each body that takes part: its surface triangles' and edges' swept boxes in
+  // the frame of the first such body, their bounds, and spatial hashes of them.
   struct ContactBroadPhase {
     std::vector<Box3f> boxes;      // per surface triangle
     std::vector<Box3f> edgeBoxes;  // per surface edge
@@ -274,11 +279,6 @@ class World {
   std::vector<ContactBroadPhase> broadPhases_;  // per body
   std::vector<std::uint32_t> seen_;             // per triangle or edge of a body: the last query that met it
   std::uint32_t contactQuery_ = 0;
-  void detectVertexTriangle(BodyId a, BodyId b);  // a's vertices against b's triangles
-  void detectEdgeEdge(BodyId a, BodyId b);        // a's edges against b's
-  bool touching(BodyId a, BodyId b) const;        // the pair's settings let them touch
-  Box3f sweptBox(Index particle, const Vec3& offset, float grow) const;
-  static ContactSurface contactSurfaceOf(const BodyModel& model);
   // The last substep's contacts, whose multipliers a warm start carries over.
   std::vector<ColliderContact> previousColliderContacts_;
   std::vector<FingertipContact> previousFingertipContacts_;
