@@ -58,7 +58,6 @@ World::ContactSurface World::contactSurfaceOf(const BodyModel& model) {
   };
   sortUnique(surface.vertices);
   sortUnique(surface.edges);
-  surface.closed = !model.tets.empty();
   return surface;
 }
 
@@ -173,7 +172,8 @@ void World::detectVertexTriangle(BodyId a, BodyId bId) {
                                    other.firstParticle + tri[2]};
       if (pred[p[0]].w == 0.0f && pred[p[1]].w == 0.0f && pred[p[2]].w == 0.0f && pred[p[3]].w == 0.0f) return;
       const std::optional<VertexTriangleTouch> touch = touchVertexTriangle(
-          start[i].pos, start[p[1]].pos + offset, start[p[2]].pos + offset, start[p[3]].pos + offset, surfaceB.closed);
+          start[i].pos, start[p[1]].pos + offset, start[p[2]].pos + offset, start[p[3]].pos + offset,
+          !other.model->tets.empty());  // a soft body's surface is closed
       if (!touch) return;
       float reach = 0.0f;
       for (int k = 1; k < 4; ++k) reach = std::max(reach, (pred[p[k]].pos - start[p[k]].pos).norm());
@@ -183,16 +183,8 @@ void World::detectVertexTriangle(BodyId a, BodyId bId) {
         if ((rest[v] - (w[0] * rest[tri[0]] + w[1] * rest[tri[1]] + w[2] * rest[tri[2]])).norm() <= gap) return;
       }
       const std::uint64_t key = std::uint64_t(i) << 32 | (surfaceB.firstTriangleKey + t);
-      bodyContacts_.push_back({p,
-                               {1.0f, -touch->b[0], -touch->b[1], -touch->b[2]},
-                               1,
-                               key,
-                               offset,
-                               touch->normal,
-                               gap,
-                               pair.compliance,
-                               pair.staticFriction,
-                               pair.dynamicFriction});
+      bodyContacts_.push_back(
+          {p, {1.0f, -touch->b[0], -touch->b[1], -touch->b[2]}, 1, key, offset, touch->normal, pair});
     });
   }
 }
@@ -235,16 +227,8 @@ void World::detectEdgeEdge(BodyId a, BodyId bId) {
       }
       const std::uint64_t key =
           1ull << 63 | std::uint64_t(surfaceA.firstEdgeKey + e) << 32 | (surfaceB.firstEdgeKey + f);
-      bodyContacts_.push_back({p,
-                               {1.0f - touch->s, touch->s, touch->t - 1.0f, -touch->t},
-                               2,
-                               key,
-                               offset,
-                               touch->normal,
-                               gap,
-                               pair.compliance,
-                               pair.staticFriction,
-                               pair.dynamicFriction});
+      bodyContacts_.push_back(
+          {p, {1.0f - touch->s, touch->s, touch->t - 1.0f, -touch->t}, 2, key, offset, touch->normal, pair});
     });
   }
 }
@@ -263,7 +247,7 @@ void World::solveBodyContacts(float invH) {
       x0[k] = start[con.particle[k]].pos + offset;
     }
     const BodyContactCorrection r =
-        solveBodyContact(x, con, bodyContactLambda_[c], XpbdCoefficients::make(con.compliance, 0.0f, invH));
+        solveBodyContact(x, con, bodyContactLambda_[c], XpbdCoefficients::make(con.pair.compliance, 0.0f, invH));
     bodyContactLambda_[c] += r.dLambda;
     for (std::size_t k = 0; k < 4; ++k) x[k].pos += r.dx[k];
     const Vec3 friction = bodyContactFriction(x, x0, con, bodyContactLambda_[c], bodyContactFrictionLambda_[c]);

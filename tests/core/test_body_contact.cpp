@@ -57,7 +57,7 @@ TEST(VertexTriangleTouch, DegenerateTrianglesAndVerticesOnAnEdgeMakeNone) {
 }
 
 BodyContact contactOf(const VertexTriangleTouch& t, float gap, float mu = 0.0f) {
-  return {{0, 1, 2, 3}, {1.0f, -t.b[0], -t.b[1], -t.b[2]}, 1, 0, Vec3::Zero(), t.normal, gap, 0.0f, mu, mu};
+  return {{0, 1, 2, 3}, {1.0f, -t.b[0], -t.b[1], -t.b[2]}, 1, 0, Vec3::Zero(), t.normal, {gap, 0.0f, mu, mu}};
 }
 
 TEST(EdgeEdgeTouch, CrossedEdgesMeetAtTheirClosestPoints) {

@@ -52,10 +52,7 @@ struct BodyContact {
   std::uint64_t key;              ///< identifies the pair of features, for the warm start
   Vec3 offset;                    ///< from the other body's frame to the first's (0 within a body)
   Vec3 normal;                    ///< unit, from the other body's point towards the first's
-  float gap;                      ///< the distance kept: the two bodies' thicknesses
-  float compliance;               ///< the two bodies' compliances in series (m/N)
-  float staticFriction;           ///< mu_s of the pair
-  float dynamicFriction;          ///< mu_k of the pair
+  ContactPair pair;               ///< the gap, compliance and frictions of the two bodies
 };
 
 /// Where a vertex x meets triangle (a, b, c): the contact normal, the contact point's weights and
@@ -141,7 +138,7 @@ inline BodyContactCorrection solveBodyContact(const std::array<Point, 4>& x, con
     d += c.weight[j] * x[j].pos;
     inverseMass += c.weight[j] * c.weight[j] * x[j].w;
   }
-  const float C = c.normal.dot(d) - c.gap;
+  const float C = c.normal.dot(d) - c.pair.gap;
   if ((C >= 0.0f && lambda <= 0.0f) || !(inverseMass > 0.0f)) return out;
   out.dLambda = std::max(lambda + deltaLambda(C, lambda, inverseMass, k), 0.0f) - lambda;
   for (std::size_t j = 0; j < 4; ++j) out.dx[j] = (x[j].w * c.weight[j] * out.dLambda) * c.normal;
@@ -159,8 +156,8 @@ inline Vec3 bodyContactFriction(const std::array<Point, 4>& x, const std::array<
     motion += c.weight[j] * (x[j].pos - x0[j]);
     inverseMass += c.weight[j] * c.weight[j] * x[j].w;
   }
-  return frictionDelta(motion, c.normal, inverseMass, lambdaFriction, lambdaNormal, c.staticFriction,
-                       c.dynamicFriction);
+  return frictionDelta(motion, c.normal, inverseMass, lambdaFriction, lambdaNormal, c.pair.staticFriction,
+                       c.pair.dynamicFriction);
 }
 
 }  // namespace vrd

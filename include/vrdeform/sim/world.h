@@ -257,7 +257,6 @@ class World {
     std::vector<Index> vertices;                   // the surface's vertices (body-local, ascending)
     std::vector<std::array<Index, 2>> edges;       // its edges (body-local, lower first, ascending)
     Index firstTriangleKey = 0, firstEdgeKey = 0;  // world-wide numbers of its first triangle and edge
-    bool closed = false;                           // a soft body's boundary (outward); a cloth is two-sided
   };
   static ContactSurface contactSurfaceOf(const BodyModel& model);
   std::vector<BodyContactSettings> bodyContactSettings_;
