@@ -121,10 +121,10 @@ PlacedMesh placeBodyMesh(const BodySpec& body, const SceneLog& log, const std::f
   return out;
 }
 
-// Lifts a placed body so that its lowest point sits the two bodies' thicknesses above the highest
-// particle of body `b.on` under its footprint (x and z), or above that body's top if none is under it.
 namespace {
 
+// Lifts a placed body so that its lowest point sits the two bodies' thicknesses above the highest
+// particle of body `b.on` under its footprint (x and z), or above that body's top if none is under it.
 void placeOn(PlacedMesh& mesh, const BuiltScene& scene, const BodySpec& b) {
   const SceneBody& below = scene.body(b.on);
   const World& world = *scene.world;

@@ -738,6 +738,10 @@ OutputSpec readOutput(const Table& t) {
   return out;
 }
 
+bool hasBody(const std::vector<BodySpec>& bodies, std::string_view name) {
+  return std::any_of(bodies.begin(), bodies.end(), [&](const BodySpec& b) { return b.name == name; });
+}
+
 SceneSpec readScene(const Table& root, std::string_view sourceName) {
   root.allowOnly({"format", "name", "description", "settle", "seconds", "wind", "ground", "solver", "body", "collider",
                   "no_contact", "hand", "haptics", "output"});
@@ -764,8 +768,7 @@ SceneSpec readScene(const Table& root, std::string_view sourceName) {
     for (std::size_t i = 0; i < scene.bodies.size(); ++i)
       if (scene.bodies[i].name == body.name)
         t.fail("name", fmt::format("'{}' is also the name of body[{}]", printable(body.name), i + 1));
-    if (!body.on.empty() &&
-        std::none_of(scene.bodies.begin(), scene.bodies.end(), [&](const BodySpec& b) { return b.name == body.on; }))
+    if (!body.on.empty() && !hasBody(scene.bodies, body.on))
       t.fail("on", fmt::format("no body '{}' before this one", printable(body.on)));
     scene.bodies.push_back(std::move(body));
   }
@@ -775,8 +778,7 @@ SceneSpec readScene(const Table& root, std::string_view sourceName) {
     if (names.size() != 2) t.fail("bodies", fmt::format("needs two body names, got {}", names.size()));
     std::array<std::string, 2> pair{names[0].name(), names[1].name()};
     for (const std::string& name : pair)
-      if (std::none_of(scene.bodies.begin(), scene.bodies.end(), [&](const BodySpec& b) { return b.name == name; }))
-        t.fail("bodies", fmt::format("no body '{}'", printable(name)));
+      if (!hasBody(scene.bodies, name)) t.fail("bodies", fmt::format("no body '{}'", printable(name)));
     if (pair[0] == pair[1]) t.fail("bodies", "names one body twice (its self-contact is [body.contact] self)");
     scene.noContact.push_back(std::move(pair));
   }

@@ -594,13 +594,12 @@ void World::detectTriangleContacts() {
 
 namespace {
 
-// For each contact of `now`, the index of the same contact in `before` (or npos): both lists in
-// the order detection makes them, by particle and then by collider or fingertip.
-template <typename Contact, typename Other>
-std::vector<std::size_t> sameContacts(const std::vector<Contact>& before, const std::vector<Contact>& now,
-                                      Other other) {
+// For each contact of `now`, the index of the same contact in `before` (or npos): both lists
+// ascending in `key` (detection's order: by particle and then by collider or fingertip; body
+// contacts by BodyContact::key).
+template <typename Contact, typename Key>
+std::vector<std::size_t> sameContacts(const std::vector<Contact>& before, const std::vector<Contact>& now, Key key) {
   std::vector<std::size_t> out(now.size(), std::string::npos);
-  const auto key = [&](const Contact& c) { return std::pair{c.particle, c.*other}; };
   for (std::size_t i = 0, j = 0; i < now.size(); ++i) {
     while (j < before.size() && key(before[j]) < key(now[i])) ++j;
     if (j < before.size() && key(before[j]) == key(now[i])) out[i] = j;
@@ -651,7 +650,9 @@ void World::resetMultipliers(const SolverTeam& team) {
     for (std::size_t a = 0; a < attachments_.size(); ++a)  // C = x - target: grad C^T lambda is lambda
       if (const Index p = attachments_[a].particle; p != kNoParticle) pred[p].pos += pred[p].w * attachmentLambda_[a];
     const std::vector<std::size_t> collider =
-        sameContacts(previousColliderContacts_, colliderContacts_, &ColliderContact::collider);
+        sameContacts(previousColliderContacts_, colliderContacts_, [](const ColliderContact& c) {
+          return std::pair{c.particle, c.collider};
+        });
     carry(contactNormalLambda_, collider, 0.0f);
     carry(contactFrictionLambda_, collider, Vec3(Vec3::Zero()));
     for (std::size_t c = 0; c < colliderContacts_.size(); ++c) {
@@ -662,7 +663,9 @@ void World::resetMultipliers(const SolverTeam& team) {
       q.pos += q.w * (contactNormalLambda_[c] * n + contactFrictionLambda_[c]);
     }
     const std::vector<std::size_t> tip =
-        sameContacts(previousFingertipContacts_, fingertipContacts_, &FingertipContact::fingertip);
+        sameContacts(previousFingertipContacts_, fingertipContacts_, [](const FingertipContact& c) {
+          return std::pair{c.particle, c.fingertip};
+        });
     carry(fingertipLambda_, tip, 0.0f);
     carry(fingertipFrictionLambda_, tip, Vec3(Vec3::Zero()));
     for (std::size_t c = 0; c < fingertipContacts_.size(); ++c) {
@@ -719,11 +722,8 @@ void World::resetMultipliers(const SolverTeam& team) {
 // Body contacts found again keep their multipliers and push as they did, along their contact
 // planes (fixed over a substep, so the inertial predictions' gradients are the solver's).
 void World::carryBodyContacts() {
-  std::vector<std::size_t> same(bodyContacts_.size(), std::string::npos);  // both lists sorted by key
-  for (std::size_t i = 0, j = 0; i < bodyContacts_.size(); ++i) {
-    while (j < previousBodyContacts_.size() && previousBodyContacts_[j].key < bodyContacts_[i].key) ++j;
-    if (j < previousBodyContacts_.size() && previousBodyContacts_[j].key == bodyContacts_[i].key) same[i] = j;
-  }
+  const std::vector<std::size_t> same =
+      sameContacts(previousBodyContacts_, bodyContacts_, [](const BodyContact& c) { return c.key; });
   carry(bodyContactLambda_, same, 0.0f);
   carry(bodyContactFrictionLambda_, same, Vec3(Vec3::Zero()));
   Point* const pred = predicted_.data();
