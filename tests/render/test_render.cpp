@@ -289,7 +289,9 @@ TEST(MouseHand, PokesAndPinchesTheBodyUnderTheCursor) {
   EXPECT_GT(session.grasp().heldParticles(), 0u);
   EXPECT_GT(bodyBounds(*scene.world, 0).max().y(), top + 0.01f) << "the held part follows the hand up";
   m.pinch = false;
-  run(1.5);
+  // Released, the fingers open to 2 cm wider than the pinch began: from fully closed, 4 cm plus the
+  // two fingertips' closing depth at the closing speed.
+  run((0.04 + 2.0 * radius * mouse.settings.pinchDepth) / mouse.settings.closingSpeed + 0.1);
   EXPECT_FALSE(session.grasp().active());
   EXPECT_FALSE(mouse.busy());
 }

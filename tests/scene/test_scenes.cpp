@@ -27,10 +27,10 @@ TEST(Scenes, ThePapersSixAndTheContactScenesAreBuiltIn) {
                                                "liver", "liver_pad"}));
 }
 
-// The paper's tet counts (Table 1): the meshers land within 15% of them.
+// The paper's tet counts (Table 1): the meshers land within 15% of them. The liver is the CT
+// surface's own tets instead (1,177, not 770: scenes/liver.toml says why).
 TEST(Scenes, TetCountsAreNearThePapers) {
-  const std::map<std::string, std::size_t> paper{
-      {"furball", 1280}, {"liver", 770}, {"balloon", 1713}, {"jelly", 1530}, {"bear", 1041}};
+  const std::map<std::string, std::size_t> paper{{"furball", 1280}, {"balloon", 1713}, {"jelly", 1530}, {"bear", 1041}};
   for (const auto& [name, tets] : paper) {
     SceneSpec spec = loadSceneByName(name);
     spec.settle = 0.0;
@@ -39,6 +39,22 @@ TEST(Scenes, TetCountsAreNearThePapers) {
     const double n = double(scene.bodies.front().model->tets.size());
     EXPECT_NEAR(n / double(tets), 1.0, 0.15) << name << ": " << n << " tets";
   }
+}
+
+// The liver's drawn surface (liver.obj, 2,557 vertices) is where its tets are, so a fingertip meets
+// the body where the eye sees it: its tets keep liver_coarse.obj's triangles as their boundary, and
+// the two surfaces are remeshings of one CT level set (facet distances 0.7 and 3 mm), so no drawn
+// vertex lies more than about 4 mm outside the body (a 770-tet lattice left 18 mm).
+TEST(Scenes, TheLiversDrawnSurfaceLiesOnItsTets) {
+  SceneSpec spec = loadSceneByName("liver");
+  spec.settle = 0.0;
+  spec.haptics.calibrate = false;
+  const BuiltScene scene = buildScene(spec);
+  ASSERT_TRUE(scene.bodies.front().embedding);
+  const Embedding& drawn = *scene.bodies.front().embedding;
+  EXPECT_EQ(drawn.vertexCount(), 2557u);
+  testing::record("max_outside_distance_m", drawn.maxOutsideDistance());
+  EXPECT_LT(drawn.maxOutsideDistance(), 0.005);
 }
 
 class EveryScene : public ::testing::TestWithParam<std::string> {};
@@ -200,8 +216,9 @@ depth = 0.015
   testing::record("hold_noise_newtons", r.pokes[0].newtons.holdNoise);
 }
 
-// The liver's poke, held for a second, read in newtons: cold (the scene as it is, 8 x 5) far from a
-// converged run of the same scene (2 x the substeps, 4 x the iterations); with a warm start
+// The liver's poke, held for a second, read in newtons: cold (the scene as it is, 8 x 5) off by more
+// than half from a converged run of the same scene (2 x the substeps, 4 x the iterations; whether
+// above or below depends on the mesh); with a warm start
 // (SolverSettings::warmStart), which makes the held body a fixed point of any number of
 // iterations, within 5% of it.
 TEST(Scenes, AWarmStartedPokeReadsTheConvergedNewtons) {
@@ -221,7 +238,7 @@ TEST(Scenes, AWarmStartedPokeReadsTheConvergedNewtons) {
   };
   const double converged = peak(true, 2, 4), warm = peak(true, 1, 1), cold = peak(false, 1, 1);
   EXPECT_NEAR(warm, converged, 0.05 * converged);
-  EXPECT_GT(cold, 1.5 * converged);
+  EXPECT_GT(std::max(cold / converged, converged / cold), 1.5);
   testing::record("warm_newtons", warm);
   testing::record("cold_newtons", cold);
   testing::record("converged_newtons", converged);
@@ -440,8 +457,8 @@ TEST(SceneBuilder, StopsWhileMeshingSettlingOrCalibrating) {
     }
     return std::string("not stopped");
   };
-  SceneSpec liver = loadSceneByName("liver");  // a surface, meshed by the built-in mesher
-  EXPECT_EQ(stoppedAt(liver, 0), "stopped while meshing body 'liver'");
+  EXPECT_EQ(stoppedAt(loadSceneByName("jelly"), 0), "stopped while meshing body 'jelly'");  // a surface
+  SceneSpec liver = loadSceneByName("liver");
   std::vector<std::pair<double, double>> settled;
   const std::string settling = stoppedAt(liver, 30, &settled);
   EXPECT_EQ(settling.rfind("stopped while settling, ", 0), 0u) << settling;

@@ -277,6 +277,36 @@ TEST(BodyContact, AFingertipPressingOneBodyIntoAnotherFeelsTheOther) {
   EXPECT_FALSE(crossing(surfaces(w, {pad, top})));
 }
 
+// A pinch squeezing one body against another: two fingertips close on two 5 cm blocks side by side
+// (no gravity, so nothing else pushes). At rest each block's forces balance along the squeeze: the
+// thumb's push on one, the index's on the other and the contact between them are one force (5%:
+// the multipliers of a warm-started run at rest), and the surfaces never cross.
+TEST(BodyContact, APinchSqueezingOneBodyAgainstAnotherFeelsTheOther) {
+  SolverSettings s = restingSettings();
+  s.gravity = Vec3::Zero();
+  World w(s);
+  const Vec3 size(0.05f, 0.05f, 0.05f);
+  const BodyId left = w.addBody(block(size, 3, 3, 3, 2e4f), Vec3(-0.0505f, 0.0f, -0.025f));
+  const BodyId right = w.addBody(block(size, 3, 3, 3, 2e4f), Vec3(0.0005f, 0.0f, -0.025f));
+  const float radius = 0.01f;
+  const Vec3 thumbStart(-0.0505f - radius - 0.005f, 0.025f, 0.0f), indexStart(-thumbStart.x(), 0.025f, 0.0f);
+  const FingertipId thumb = w.addFingertip(thumbStart, radius, 0.0f, FingertipContactMode::Triangles);
+  const FingertipId index = w.addFingertip(indexStart, radius, 0.0f, FingertipContactMode::Triangles);
+  for (int step = 1; step <= 90; ++step) {  // each 1.5 cm inwards in 1 s (1 cm into the pair), then hold 0.5 s
+    const Vec3 in(0.015f * float(std::min(step, 60)) / 60.0f, 0.0f, 0.0f);
+    w.moveFingertip(thumb, thumbStart + in);
+    w.moveFingertip(index, indexStart - in);
+    w.step();
+    ASSERT_FALSE(crossing(surfaces(w, {left, right}))) << "step " << step;
+  }
+  const float thumbPush = w.fingertipForce(thumb).x(), indexPush = -w.fingertipForce(index).x();  // on the blocks
+  const float between = w.bodyContactForce(right, left).x();  // what the left block pushes the right one with
+  EXPECT_GT(thumbPush, 0.5f) << "the pinch should squeeze hard enough for the test to mean something";
+  EXPECT_NEAR(indexPush, thumbPush, 0.05f * thumbPush);
+  EXPECT_NEAR(between, thumbPush, 0.05f * thumbPush);
+  EXPECT_NEAR(w.bodyContactForce(left, right).x(), -between, 1e-3f * between);
+}
+
 // Degenerate input: two bodies made in the same place (every vertex on another's), and a body
 // thrown at 1 km/s into another: the steps stay finite and bounded.
 TEST(BodyContact, OverlappingAndHugeSpeedsGiveNoNanAndNoBlowUp) {
