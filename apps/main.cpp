@@ -8,6 +8,7 @@
 #include "run_command.h"
 #include "serve_command.h"
 #include "soak_command.h"
+#include "study_command.h"
 #include "touch_command.h"
 #include "view_command.h"
 #include "vrdeform/error.h"
@@ -25,6 +26,7 @@ int main(int argc, char** argv) {
   const auto runViewCommand = vrd::addViewCommand(app);
   const auto runServeCommand = vrd::addServeCommand(app);
   const auto runSoakCommand = vrd::addSoakCommand(app);
+  const auto runStudyCommand = vrd::addStudyCommand(app);
 
   // Exit status: 0 fine; 1 a run failed part-way, a mesh has defects or a replay differs; 2 bad
   // input, usage errors included (CLI11's own codes are folded into 2); 130 stopped by Ctrl-C (or
@@ -43,6 +45,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("view")) return runViewCommand();
     if (app.got_subcommand("serve")) return runServeCommand();
     if (app.got_subcommand("soak")) return runSoakCommand();
+    if (app.got_subcommand("study")) return runStudyCommand();
   } catch (const vrd::Error& e) {
     fmt::print(stderr, "vrdeform: {}\n", e.what());
     return 2;

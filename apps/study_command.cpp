@@ -1,0 +1,75 @@
+#include "study_command.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "vrdeform/study/study_analysis.h"
+#include "vrdeform/study/study_file.h"
+
+namespace vrd {
+namespace {
+
+struct StudyArgs {
+  std::string study, data, out;
+  std::size_t participants = 0;
+};
+
+int check(const StudyArgs& a) {
+  const StudySpec s = loadStudy(a.study);
+  fmt::print("study {}: {} conditions, {} tasks x {} trials, {} questions in {} dimensions, {} comparisons\n", s.name,
+             s.conditions.size(), s.tasks.size(), s.trials, s.questions.size(), s.dimensions().size(),
+             s.comparisons.size());
+  for (const StudyCondition& c : s.conditions)
+    fmt::print("  condition {}: scene {}, force {}\n", c.name, c.scene,
+               c.force == StudyForce::Multipliers ? "multipliers (A)" : "baseline (B)");
+  const std::size_t n = a.participants > 0 ? a.participants : 2 * s.conditions.size();
+  for (std::size_t k = 1; k <= n; ++k) {
+    std::vector<std::string_view> order;
+    for (std::size_t c : s.orderOf(k)) order.push_back(s.conditions[c].name);
+    fmt::print("  P{}: {}\n", k, fmt::join(order, ", "));
+  }
+  return 0;
+}
+
+int analyse(const StudyArgs& a) {
+  const StudySpec s = loadStudy(a.study);
+  const std::vector<ParticipantAnswers> participants = readStudyAnswers(s, a.data);
+  const StudyAnalysis analysis = analyseStudy(s, participants);
+  const std::string out = a.out.empty() ? (std::filesystem::path(a.data) / "analysis").string() : a.out;
+  writeStudyAnalysis(s, participants, analysis, out);
+  for (const PairedTest& t : analysis.tests)
+    if (t.dimension)
+      fmt::print("{:<12} {} vs {}: {} pairs, W+ {}, p {:.4f}{}, r {:.2f}\n", t.measure, s.conditions[t.a].name,
+                 s.conditions[t.b].name, t.pairs, t.result.wPlus, t.result.p, t.result.exact ? " (exact)" : "",
+                 t.result.effectSize);
+  fmt::print("wrote {}/: report.md tidy.csv descriptive.csv tests.csv order.csv comparisons.csv\n", out);
+  return 0;
+}
+
+}  // namespace
+
+std::function<int()> addStudyCommand(CLI::App& app) {
+  auto a = std::make_shared<StudyArgs>();
+  CLI::App* cmd = app.add_subcommand("study", "A within-subject haptics study from a study file (docs/study.md)");
+  cmd->require_subcommand(1);
+  CLI::App* checkCmd = cmd->add_subcommand("check", "Read a study file; print its plan and the participants' orders");
+  checkCmd->add_option("study", a->study, "The study file (.toml)")->required();
+  checkCmd->add_option("--participants", a->participants, "Orders to print (default: two of each)")
+      ->check(CLI::Range(1, 10000));
+  CLI::App* analyseCmd =
+      cmd->add_subcommand("analyse", "Statistics and a report from the participants' answers (DATA/P1, DATA/P2, ...)");
+  analyseCmd->add_option("study", a->study, "The study file (.toml)")->required();
+  analyseCmd->add_option("data", a->data, "The study's data folder")->required();
+  analyseCmd->add_option("--out", a->out, "Where the report goes (default: DATA/analysis)");
+  return [a, checkCmd, analyseCmd]() -> int {
+    if (*checkCmd) return check(*a);
+    if (*analyseCmd) return analyse(*a);
+    return 0;
+  };
+}
+
+}  // namespace vrd

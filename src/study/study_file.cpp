@@ -1,0 +1,167 @@
+// Study files (docs/study.md): the schema of a within-subject study, read with the scene files'
+// TOML helpers so that every message names the file, the line and the key.
+#include "vrdeform/study/study_file.h"
+
+#include <algorithm>
+
+#include "scene/toml_schema.h"
+#include "vrdeform/metrics/latin_square.h"
+#include "vrdeform/scene/scene_library.h"
+
+namespace vrd {
+namespace {
+
+using namespace schema;
+
+// A built-in scene's name as it is; a scene file (a '/' or a .toml ending, as loadSceneByName
+// tells them apart) checked to exist and made absolute.
+std::string readSceneName(const Field& f) {
+  const std::string name = f.name();
+  if (name.find('/') != std::string::npos || name.ends_with(".toml")) return f.file();
+  std::vector<std::string> known;
+  for (const SceneEntry& e : builtinScenes()) known.push_back(e.name);
+  if (std::find(known.begin(), known.end(), name) == known.end())
+    f.fail(fmt::format("no built-in scene '{}' (built in: {}; a scene file's path has a '/' or ends in .toml)",
+                       printable(name), fmt::join(known, ", ")));
+  return name;
+}
+
+// A name the data files hold as a CSV field.
+std::string csvName(const Field& f) {
+  std::string name = f.name();
+  if (name.find_first_of(",\"\r\n") != std::string::npos)
+    f.fail("must not contain a comma, a quote or a line break (the data files hold it as a CSV field)");
+  return name;
+}
+
+// Names unique within `seen`, which it extends.
+void checkUnique(const Field& f, const std::string& name, std::vector<std::string>& seen, std::string_view what) {
+  if (std::find(seen.begin(), seen.end(), name) != seen.end())
+    f.fail(fmt::format("'{}' is the {} of an earlier entry too", printable(name), what));
+  seen.push_back(name);
+}
+
+StudySpec readStudy(const Table& root) {
+  root.allowOnly({"format", "name", "description", "trials", "rest", "points", "comparison_range", "order",
+                  "condition", "task", "question", "comparison"});
+  if (const std::int64_t format = root.require("format").integer(); format != 1)
+    root.fail("format", fmt::format("unknown format {} (this vrdeform reads format 1)", format));
+  StudySpec s;
+  s.name = root.require("name").name();
+  root.readString("description", s.description);
+  root.readInt("trials", s.trials, 1, 100);
+  root.readNumber("rest", s.restSeconds, kNonNegative);
+  root.readInt("points", s.points, 2, 11);
+  root.readInt("comparison_range", s.comparisonRange, 1, 5);
+  constexpr Option<Counterbalancing> kOrders[] = {{"latin_square", Counterbalancing::LatinSquare},
+                                                  {"fixed", Counterbalancing::Fixed}};
+  root.readChoice("order", s.order, kOrders);
+
+  std::vector<std::string> names;
+  for (const Table& t : root.tables("condition")) {
+    t.allowOnly({"name", "scene", "force"});
+    StudyCondition c;
+    const Field name = t.require("name");
+    c.name = csvName(name);
+    checkUnique(name, c.name, names, "name");
+    c.scene = readSceneName(t.require("scene"));
+    constexpr Option<StudyForce> kForces[] = {{"multipliers", StudyForce::Multipliers},
+                                              {"baseline", StudyForce::Baseline}};
+    t.readChoice("force", c.force, kForces);
+    s.conditions.push_back(std::move(c));
+  }
+  if (s.conditions.size() < 2) root.fail("condition", "a within-subject study needs two or more [[condition]]s");
+
+  names.clear();
+  for (const Table& t : root.tables("task")) {
+    t.allowOnly({"name", "instructions", "seconds"});
+    StudyTask task;
+    const Field name = t.require("name");
+    task.name = name.name();
+    checkUnique(name, task.name, names, "name");
+    t.readString("instructions", task.instructions);
+    t.readNumber("seconds", task.seconds, kNonNegative);
+    s.tasks.push_back(std::move(task));
+  }
+  if (s.tasks.empty()) root.fail("task", "needs at least one [[task]]");
+
+  std::vector<std::string> ids;
+  for (const Table& t : root.tables("question")) {
+    t.allowOnly({"id", "dimension", "text", "anchors"});
+    StudyQuestion q;
+    const Field id = t.require("id");
+    q.id = csvName(id);
+    checkUnique(id, q.id, ids, "id");
+    q.dimension = csvName(t.require("dimension"));
+    q.text = t.require("text").name();
+    if (const std::optional<Field> f = t.get("anchors")) {
+      const std::vector<Field> anchors = f->elements("an array of two strings");
+      if (anchors.size() != 2) f->fail(fmt::format("expected two anchors (of 1 and of {}), got {}", s.points, anchors.size()));
+      q.low = anchors[0].name();
+      q.high = anchors[1].name();
+    }
+    s.questions.push_back(std::move(q));
+  }
+  for (const Table& t : root.tables("comparison")) {
+    t.allowOnly({"id", "text", "between"});
+    StudyComparison c;
+    const Field id = t.require("id");
+    c.id = csvName(id);
+    checkUnique(id, c.id, ids, "id");
+    c.text = t.require("text").name();
+    if (const std::optional<Field> f = t.get("between")) {
+      const std::vector<Field> pair = f->elements("an array of two condition names");
+      if (pair.size() != 2) f->fail(fmt::format("expected two condition names, got {}", pair.size()));
+      std::size_t index[2];
+      for (int k = 0; k < 2; ++k) {
+        const std::string name = pair[k].name();
+        const auto it = std::find_if(s.conditions.begin(), s.conditions.end(),
+                                     [&](const StudyCondition& x) { return x.name == name; });
+        if (it == s.conditions.end()) pair[k].fail(fmt::format("no condition '{}'", printable(name)));
+        index[k] = std::size_t(it - s.conditions.begin());
+      }
+      if (index[0] == index[1]) f->fail("names one condition twice");
+      c.a = index[0];
+      c.b = index[1];
+    }
+    s.comparisons.push_back(std::move(c));
+  }
+  if (s.questions.empty() && s.comparisons.empty())
+    root.fail("question", "needs at least one [[question]] or [[comparison]]");
+  return s;
+}
+
+}  // namespace
+
+std::vector<std::size_t> StudySpec::orderOf(std::size_t participant) const {
+  if (participant == 0) throw Error("participants are numbered from 1");
+  if (order == Counterbalancing::LatinSquare) return latinSquareOrder(conditions.size(), participant - 1);
+  std::vector<std::size_t> fixed(conditions.size());
+  for (std::size_t i = 0; i < fixed.size(); ++i) fixed[i] = i;
+  return fixed;
+}
+
+std::vector<std::string> StudySpec::dimensions() const {
+  std::vector<std::string> out;
+  for (const StudyQuestion& q : questions)
+    if (std::find(out.begin(), out.end(), q.dimension) == out.end()) out.push_back(q.dimension);
+  return out;
+}
+
+StudySpec parseStudy(std::string_view text, std::string_view sourceName, const std::filesystem::path& baseDir) {
+  const Context ctx{std::string(sourceName), baseDir};
+  const toml::table root = parseToml(text, ctx.source);
+  StudySpec study = readStudy(Table(ctx, root, "", 1));
+  study.source = sourceName;
+  return study;
+}
+
+StudySpec loadStudy(const std::filesystem::path& path) {
+  std::error_code error;
+  std::filesystem::path absolute = std::filesystem::absolute(path, error);
+  if (error) absolute = path;
+  StudySpec study = parseStudy(readText(path), path.string(), absolute.lexically_normal().parent_path());
+  return study;
+}
+
+}  // namespace vrd

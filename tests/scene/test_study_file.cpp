@@ -1,0 +1,112 @@
+// Study files (study/study_file.h): the paper's study reads as written, the orders follow the
+// balanced Latin square, and every mistake is named with its file, line and key.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "vrdeform/error.h"
+#include "vrdeform/metrics/latin_square.h"
+#include "vrdeform/study/study_file.h"
+
+namespace vrd {
+namespace {
+
+const std::filesystem::path kStudies = std::filesystem::path(VRDEFORM_TEST_DATA_DIR) / ".." / "studies";
+
+constexpr const char* kSmall = R"(format = 1
+name = "small"
+[[condition]]
+name = "A"
+scene = "liver"
+[[condition]]
+name = "B"
+scene = "liver"
+force = "baseline"
+[[condition]]
+name = "C"
+scene = "jelly"
+[[task]]
+name = "poke"
+[[question]]
+id = "H1"
+dimension = "haptic"
+text = "It felt soft."
+[[comparison]]
+id = "D1"
+text = "Which was better?"
+between = ["C", "A"]
+)";
+
+std::string errorOf(const std::string& text) {
+  try {
+    parseStudy(text, "s.toml", ".");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(StudyFile, ThePapersStudyReadsAsWritten) {
+  const StudySpec s = loadStudy(kStudies / "paper.toml");
+  ASSERT_EQ(s.conditions.size(), 2u);
+  EXPECT_EQ(s.conditions[0].force, StudyForce::Multipliers);
+  EXPECT_EQ(s.conditions[1].force, StudyForce::Baseline);
+  EXPECT_EQ(s.tasks.size(), 2u);
+  EXPECT_EQ(s.trials, 3);
+  EXPECT_DOUBLE_EQ(s.restSeconds, 600.0);
+  EXPECT_EQ(s.questions.size(), 12u);
+  EXPECT_EQ(s.dimensions(), (std::vector<std::string>{"visual", "haptic", "congruence", "stability"}));
+  ASSERT_EQ(s.comparisons.size(), 4u);
+  EXPECT_EQ(s.comparisons[3].a, 0u);
+  EXPECT_EQ(s.comparisons[3].b, 1u);
+  EXPECT_EQ(s.comparisonRange, 3);
+}
+
+TEST(StudyFile, OrdersFollowTheBalancedLatinSquare) {
+  StudySpec s = parseStudy(kSmall, "s.toml", ".");
+  ASSERT_EQ(s.conditions.size(), 3u);
+  for (std::size_t k = 1; k <= 12; ++k) EXPECT_EQ(s.orderOf(k), latinSquareOrder(3, k - 1)) << "participant " << k;
+  EXPECT_NE(s.orderOf(1), s.orderOf(2));
+  EXPECT_EQ(s.comparisons[0].a, 2u);  // between = ["C", "A"]
+  EXPECT_EQ(s.comparisons[0].b, 0u);
+  s.order = Counterbalancing::Fixed;
+  EXPECT_EQ(s.orderOf(5), (std::vector<std::size_t>{0, 1, 2}));
+  EXPECT_THROW(s.orderOf(0), Error);
+}
+
+TEST(StudyFile, MistakesAreNamedWithLineAndKey) {
+  const std::string small = kSmall;
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string text = small;
+    text.replace(text.find(from), from.size(), to);
+    return errorOf(text);
+  };
+  EXPECT_EQ(with("name = \"small\"", "name = \"small\"\ntrails = 3"), "s.toml:3: trails: unknown key (did you mean 'trials'?)");
+  EXPECT_EQ(with("format = 1", "format = 2"), "s.toml:1: format: unknown format 2 (this vrdeform reads format 1)");
+  EXPECT_EQ(with("scene = \"jelly\"", "scene = \"jely\""),
+            "s.toml:12: condition[3].scene: no built-in scene 'jely' (built in: balloon, bear, drape, flag, furball, "
+            "jelly, jelly_stack, liver, liver_pad; a scene file's path has a '/' or ends in .toml)");
+  EXPECT_EQ(with("name = \"C\"", "name = \"A\""), "s.toml:11: condition[3].name: 'A' is the name of an earlier entry too");
+  EXPECT_EQ(with("id = \"D1\"", "id = \"H1\""), "s.toml:20: comparison[1].id: 'H1' is the id of an earlier entry too");
+  EXPECT_EQ(with("id = \"H1\"", "id = \"H,1\""),
+            "s.toml:16: question[1].id: must not contain a comma, a quote or a line break (the data files hold it as a "
+            "CSV field)");
+  EXPECT_EQ(with("[\"C\", \"A\"]", "[\"C\", \"Z\"]"), "s.toml:22: comparison[1].between[2]: no condition 'Z'");
+  EXPECT_EQ(with("[\"C\", \"A\"]", "[\"C\", \"C\"]"), "s.toml:22: comparison[1].between: names one condition twice");
+  EXPECT_EQ(with("force = \"baseline\"", "force = \"vendor\""),
+            "s.toml:9: condition[2].force: unknown value 'vendor' (expected one of: multipliers, baseline)");
+  EXPECT_EQ(with("name = \"small\"", "name = \"small\"\npoints = 1"), "s.toml:3: points: must be in 2..11, got 1");
+  EXPECT_EQ(errorOf("format = 1\nname = \"x\"\n[[condition]]\nname = \"A\"\nscene = \"liver\"\n"),
+            "s.toml:3: condition: a within-subject study needs two or more [[condition]]s");
+  EXPECT_EQ(errorOf("format = 1\nname = \"x\"\n[[condition]]\nname = \"A\"\nscene = \"liver\"\n[[condition]]\nname = "
+                    "\"B\"\nscene = \"liver\"\n"),
+            "s.toml:1: task: needs at least one [[task]]");
+  EXPECT_EQ(errorOf("format = 1\nname = \"x\"\n[[condition]]\nname = \"A\"\nscene = \"nope/s.toml\"\n"),
+            "s.toml:5: condition[1].scene: no such file '" +
+                (std::filesystem::current_path() / "nope/s.toml").lexically_normal().string() + "'");
+  EXPECT_EQ(errorOf("format = 1\nname = [\n"), "s.toml:2: TOML syntax: Error while parsing array: encountered end-of-file");
+}
+
+}  // namespace
+}  // namespace vrd
