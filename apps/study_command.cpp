@@ -7,15 +7,19 @@
 #include <string>
 #include <vector>
 
+#include "vrdeform/devices/stop_signals.h"
+#include "vrdeform/error.h"
 #include "vrdeform/study/study_analysis.h"
 #include "vrdeform/study/study_file.h"
+#include "vrdeform/study/study_simulation.h"
 
 namespace vrd {
 namespace {
 
 struct StudyArgs {
   std::string study, data, out;
-  std::size_t participants = 0;
+  std::size_t participants = 0, participant = 0;
+  std::uint64_t seed = 1;
 };
 
 int check(const StudyArgs& a) {
@@ -50,6 +54,32 @@ int analyse(const StudyArgs& a) {
   return 0;
 }
 
+// Simulated participants 1..N (or participant K alone), each resumed where an earlier run ended.
+int simulate(const StudyArgs& a) {
+  const StudySpec s = loadStudy(a.study);
+  const StopSignals signals;
+  std::size_t first = 1, last = a.participants > 0 ? a.participants : 2 * s.conditions.size();
+  if (a.participant > 0) first = last = a.participant;
+  for (std::size_t k = first; k <= last; ++k) {
+    StudyRunSettings settings;
+    settings.dataDir = a.data;
+    settings.participant = k;
+    settings.simulated.seed = a.seed;
+    settings.stop = [&signals] { return signals.requested(); };
+    settings.log = [](const std::string& line) { fmt::print("{}\n", line); };
+    try {
+      const StudyRunResult r = runSimulatedParticipant(s, settings);
+      fmt::print("P{}: done ({} trials run, {} kept from an earlier run)\n", k, r.trialsRun, r.trialsKept);
+    } catch (const Stopped& e) {
+      fmt::print(stderr, "\nvrdeform: {}: P{}'s finished trials are kept; run the same command again to go on\n",
+                 e.what(), k);
+      return 130;
+    }
+  }
+  fmt::print("wrote {}/P{}..P{}; next: vrdeform study analyse {} {}\n", a.data, first, last, a.study, a.data);
+  return 0;
+}
+
 }  // namespace
 
 std::function<int()> addStudyCommand(CLI::App& app) {
@@ -65,8 +95,17 @@ std::function<int()> addStudyCommand(CLI::App& app) {
   analyseCmd->add_option("study", a->study, "The study file (.toml)")->required();
   analyseCmd->add_option("data", a->data, "The study's data folder")->required();
   analyseCmd->add_option("--out", a->out, "Where the report goes (default: DATA/analysis)");
-  return [a, checkCmd, analyseCmd]() -> int {
+  CLI::App* simulateCmd = cmd->add_subcommand(
+      "simulate", "Run simulated participants through the study headless, into DATA/P1, DATA/P2, ... (resumable)");
+  simulateCmd->add_option("study", a->study, "The study file (.toml)")->required();
+  simulateCmd->add_option("data", a->data, "The study's data folder")->required();
+  simulateCmd->add_option("--participants", a->participants, "Participants 1..N (default: two of each condition)")
+      ->check(CLI::Range(1, 10000));
+  simulateCmd->add_option("--participant", a->participant, "Participant K alone")->check(CLI::Range(1, 10000));
+  simulateCmd->add_option("--seed", a->seed, "Seed of the simulated answers' noise")->capture_default_str();
+  return [a, checkCmd, analyseCmd, simulateCmd]() -> int {
     if (*checkCmd) return check(*a);
+    if (*simulateCmd) return simulate(*a);
     if (*analyseCmd) return analyse(*a);
     return 0;
   };

@@ -95,7 +95,6 @@ bool earlier(const toml::source_position& a, const toml::source_position& b) {
   return a.line != b.line ? a.line < b.line : a.column < b.column;
 }
 
-
 // Within 2 edits and fewer than the key is long: any two-letter key is 2 edits from any other.
 std::optional<std::string_view> closest(std::string_view key, const Keys& known) {
   std::optional<std::string_view> best;

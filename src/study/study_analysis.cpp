@@ -30,7 +30,8 @@ struct CsvRow {
   std::size_t line = 0;
   std::vector<std::string_view> fields;
 };
-std::vector<CsvRow> readCsv(const std::string& text, const fs::path& path, const std::vector<std::string_view>& header) {
+std::vector<CsvRow> readCsv(const std::string& text, const fs::path& path,
+                            const std::vector<std::string_view>& header) {
   std::vector<CsvRow> rows;
   std::size_t line = 0, start = 0;
   bool sawHeader = false;
@@ -109,8 +110,8 @@ ParticipantAnswers readParticipant(const StudySpec& study, const fs::path& dir, 
       const auto fail = [&](std::string_view what) {
         throw Error(fmt::format("{}:{}: {}", file.string(), row.line, what));
       };
-      const std::optional<std::size_t> d = indexOf(study.comparisons, row.fields[0],
-                                                   [](const StudyComparison& x) -> std::string_view { return x.id; });
+      const std::optional<std::size_t> d =
+          indexOf(study.comparisons, row.fields[0], [](const StudyComparison& x) -> std::string_view { return x.id; });
       if (!d) fail(fmt::format("no comparison '{}' in the study", io::printable(row.fields[0])));
       std::int64_t rating = 0;
       if (!io::parseInteger(row.fields[1], rating) || rating < -study.comparisonRange || rating > study.comparisonRange)
@@ -294,11 +295,11 @@ void writeStudyAnalysis(const StudySpec& study, const std::vector<ParticipantAns
   for (std::size_t d = 0; d < study.comparisons.size(); ++d) {
     const Description& x = analysis.comparisons[d];
     const WilcoxonResult& r = analysis.comparisonTests[d].result;
-    comparisons += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", study.comparisons[d].id,
-                               conditionName(study.comparisons[d].a), conditionName(study.comparisons[d].b), x.n,
-                               number(x.mean), number(x.sd), number(x.median), number(x.q1), number(x.q3),
-                               number(r.wPlus), number(r.wMinus), number(r.z), number(r.p),
-                               r.exact ? "exact" : "normal", number(r.effectSize));
+    comparisons +=
+        fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", study.comparisons[d].id,
+                    conditionName(study.comparisons[d].a), conditionName(study.comparisons[d].b), x.n, number(x.mean),
+                    number(x.sd), number(x.median), number(x.q1), number(x.q3), number(r.wPlus), number(r.wMinus),
+                    number(r.z), number(r.p), r.exact ? "exact" : "normal", number(r.effectSize));
   }
   writeFile(outDir / "comparisons.csv", comparisons);
 
@@ -320,23 +321,26 @@ void writeStudyAnalysis(const StudySpec& study, const std::vector<ParticipantAns
     t += "\n| measure | conditions | pairs | W+ | W- | z | p | r |\n|---|---|---:|---:|---:|---:|---:|---:|\n";
     for (const PairedTest& x : analysis.tests)
       if (x.dimension == dimensions)
-        t += fmt::format("| {} | {} vs {} | {} | {} | {} | {:.3f} | {:.4f}{} | {:.2f} |\n", x.measure, conditionName(x.a),
-                         conditionName(x.b), x.pairs, x.result.wPlus, x.result.wMinus, x.result.z, x.result.p,
-                         x.result.exact ? " (exact)" : "", x.result.effectSize);
+        t += fmt::format("| {} | {} vs {} | {} | {} | {} | {:.3f} | {:.4f}{} | {:.2f} |\n", x.measure,
+                         conditionName(x.a), conditionName(x.b), x.pairs, x.result.wPlus, x.result.wMinus, x.result.z,
+                         x.result.p, x.result.exact ? " (exact)" : "", x.result.effectSize);
     return t;
   };
-  md += "## Dimensions\n\nEach participant's mean over a dimension's items, per condition; Wilcoxon signed-rank "
-        "tests on the pairs (exact p for up to 50 untied pairs), effect size r = |z| / sqrt(n).\n\n" +
-        table(true) + "\n## Items\n\n" + table(false);
-  md += "\n## Order\n\nPer dimension, the condition each participant met first against the one met second.\n\n"
-        "| dimension | pairs | z | p |\n|---|---:|---:|---:|\n";
+  md +=
+      "## Dimensions\n\nEach participant's mean over a dimension's items, per condition; Wilcoxon signed-rank "
+      "tests on the pairs (exact p for up to 50 untied pairs), effect size r = |z| / sqrt(n).\n\n" +
+      table(true) + "\n## Items\n\n" + table(false);
+  md +=
+      "\n## Order\n\nPer dimension, the condition each participant met first against the one met second.\n\n"
+      "| dimension | pairs | z | p |\n|---|---:|---:|---:|\n";
   for (const PairedTest& t : analysis.orderTests)
     md += fmt::format("| {} | {} | {:.3f} | {:.4f} |\n", t.measure, t.pairs, t.result.z, t.result.p);
   if (!study.comparisons.empty()) {
-    md += fmt::format("\n## Direct comparisons\n\nRated on -{0}..{0}: negative favours the first condition, 0 no "
-                      "difference, positive the second; Wilcoxon signed-rank against 0.\n\n"
-                      "| item | question | conditions | n | mean | median | IQR | p |\n|---|---|---|---:|---:|---:|---|---:|\n",
-                      study.comparisonRange);
+    md += fmt::format(
+        "\n## Direct comparisons\n\nRated on -{0}..{0}: negative favours the first condition, 0 no "
+        "difference, positive the second; Wilcoxon signed-rank against 0.\n\n"
+        "| item | question | conditions | n | mean | median | IQR | p |\n|---|---|---|---:|---:|---:|---|---:|\n",
+        study.comparisonRange);
     for (std::size_t d = 0; d < study.comparisons.size(); ++d) {
       const Description& x = analysis.comparisons[d];
       md += fmt::format("| {} | {} | {} vs {} | {} | {:.2f} | {:.2f} | {:.2f}-{:.2f} | {:.4f} |\n",

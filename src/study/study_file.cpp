@@ -42,8 +42,8 @@ void checkUnique(const Field& f, const std::string& name, std::vector<std::strin
 }
 
 StudySpec readStudy(const Table& root) {
-  root.allowOnly({"format", "name", "description", "trials", "rest", "points", "comparison_range", "order",
-                  "condition", "task", "question", "comparison"});
+  root.allowOnly({"format", "name", "description", "trials", "rest", "points", "comparison_range", "order", "condition",
+                  "task", "question", "comparison"});
   if (const std::int64_t format = root.require("format").integer(); format != 1)
     root.fail("format", fmt::format("unknown format {} (this vrdeform reads format 1)", format));
   StudySpec s;
@@ -96,7 +96,8 @@ StudySpec readStudy(const Table& root) {
     q.text = t.require("text").name();
     if (const std::optional<Field> f = t.get("anchors")) {
       const std::vector<Field> anchors = f->elements("an array of two strings");
-      if (anchors.size() != 2) f->fail(fmt::format("expected two anchors (of 1 and of {}), got {}", s.points, anchors.size()));
+      if (anchors.size() != 2)
+        f->fail(fmt::format("expected two anchors (of 1 and of {}), got {}", s.points, anchors.size()));
       q.low = anchors[0].name();
       q.high = anchors[1].name();
     }

@@ -47,7 +47,10 @@ text = "Which was better?"
 
 struct Folder {
   fs::path path;
-  Folder() : path(fs::temp_directory_path() / ("vrdeform_study_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name())) {
+  Folder()
+      : path(fs::temp_directory_path() /
+             ("vrdeform_study_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+              ::testing::UnitTest::GetInstance()->current_test_info()->name())) {
     fs::remove_all(path);
     fs::create_directories(path);
   }
@@ -167,14 +170,16 @@ std::string errorOf(const fs::path& dir, const std::string& answers) {
 TEST(StudyAnalysis, BadAnswersAreNamedWithFileAndLine) {
   Folder data;
   fs::create_directories(data.path / "P1");
-  EXPECT_EQ(errorOf(data.path, "condition,item,answer\nA,H1,8\n"), "answers.csv:2: answer '8' is not an integer in 1..7");
+  EXPECT_EQ(errorOf(data.path, "condition,item,answer\nA,H1,8\n"),
+            "answers.csv:2: answer '8' is not an integer in 1..7");
   EXPECT_EQ(errorOf(data.path, "condition,item,answer\nA,H9,3\n"), "answers.csv:2: no question 'H9' in the study");
   EXPECT_EQ(errorOf(data.path, "condition,item,answer\nC,H1,3\n"), "answers.csv:2: no condition 'C' in the study");
   EXPECT_EQ(errorOf(data.path, "condition,item,answer\nA,H1,3\n\nA,H1,4\n"),
             "answers.csv:4: a second answer to H1 in condition A");
   EXPECT_EQ(errorOf(data.path, "condition,item\nA,H1\n"),
             "answers.csv:1: expected 3 comma-separated fields (condition,item,answer), got 2");
-  EXPECT_EQ(errorOf(data.path, "item,condition,answer\n"), "answers.csv:1: expected the header 'condition,item,answer'");
+  EXPECT_EQ(errorOf(data.path, "item,condition,answer\n"),
+            "answers.csv:1: expected the header 'condition,item,answer'");
   writeFile(data.path / "P1" / "answers.csv", "condition,item,answer\n");
   writeFile(data.path / "P1" / "comparisons.csv", "item,rating\nD1,4\n");
   EXPECT_THROW(readStudyAnswers(parseStudy(kStudy, "two.toml", "."), data.path), Error);

@@ -82,12 +82,14 @@ TEST(StudyFile, MistakesAreNamedWithLineAndKey) {
     text.replace(text.find(from), from.size(), to);
     return errorOf(text);
   };
-  EXPECT_EQ(with("name = \"small\"", "name = \"small\"\ntrails = 3"), "s.toml:3: trails: unknown key (did you mean 'trials'?)");
+  EXPECT_EQ(with("name = \"small\"", "name = \"small\"\ntrails = 3"),
+            "s.toml:3: trails: unknown key (did you mean 'trials'?)");
   EXPECT_EQ(with("format = 1", "format = 2"), "s.toml:1: format: unknown format 2 (this vrdeform reads format 1)");
   EXPECT_EQ(with("scene = \"jelly\"", "scene = \"jely\""),
             "s.toml:12: condition[3].scene: no built-in scene 'jely' (built in: balloon, bear, drape, flag, furball, "
             "jelly, jelly_stack, liver, liver_pad; a scene file's path has a '/' or ends in .toml)");
-  EXPECT_EQ(with("name = \"C\"", "name = \"A\""), "s.toml:11: condition[3].name: 'A' is the name of an earlier entry too");
+  EXPECT_EQ(with("name = \"C\"", "name = \"A\""),
+            "s.toml:11: condition[3].name: 'A' is the name of an earlier entry too");
   EXPECT_EQ(with("id = \"D1\"", "id = \"H1\""), "s.toml:20: comparison[1].id: 'H1' is the id of an earlier entry too");
   EXPECT_EQ(with("id = \"H1\"", "id = \"H,1\""),
             "s.toml:16: question[1].id: must not contain a comma, a quote or a line break (the data files hold it as a "
@@ -105,7 +107,8 @@ TEST(StudyFile, MistakesAreNamedWithLineAndKey) {
   EXPECT_EQ(errorOf("format = 1\nname = \"x\"\n[[condition]]\nname = \"A\"\nscene = \"nope/s.toml\"\n"),
             "s.toml:5: condition[1].scene: no such file '" +
                 (std::filesystem::current_path() / "nope/s.toml").lexically_normal().string() + "'");
-  EXPECT_EQ(errorOf("format = 1\nname = [\n"), "s.toml:2: TOML syntax: Error while parsing array: encountered end-of-file");
+  EXPECT_EQ(errorOf("format = 1\nname = [\n"),
+            "s.toml:2: TOML syntax: Error while parsing array: encountered end-of-file");
 }
 
 }  // namespace

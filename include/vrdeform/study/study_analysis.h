@@ -42,7 +42,7 @@ Description describe(std::vector<double> values);
 /// The values of one item (a question's answers) or one dimension (each participant's mean over the
 /// dimension's questions they answered) in one condition, per participant (nullopt: none).
 struct Measure {
-  std::string name;       ///< question id or dimension name
+  std::string name;  ///< question id or dimension name
   bool dimension = false;
   std::vector<std::vector<std::optional<double>>> byCondition;  ///< [condition][participant]
 };

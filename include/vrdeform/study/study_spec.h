@@ -53,9 +53,9 @@ struct StudySpec {
   std::string source;  ///< the file it came from
   std::vector<StudyCondition> conditions;
   std::vector<StudyTask> tasks;
-  int trials = 3;         ///< per task and condition
-  double restSeconds = 0;  ///< between conditions
-  int points = 7;          ///< of every Likert item
+  int trials = 3;           ///< per task and condition
+  double restSeconds = 0;   ///< between conditions
+  int points = 7;           ///< of every Likert item
   int comparisonRange = 3;  ///< direct comparisons are rated on -range..range
   std::vector<StudyQuestion> questions;
   std::vector<StudyComparison> comparisons;

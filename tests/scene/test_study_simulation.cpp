@@ -1,0 +1,152 @@
+// Simulated participants (study/study_simulation.h): a whole study runs headless, each participant
+// in their Latin-square order, and a run stopped part-way resumes without losing a finished trial.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "vrdeform/error.h"
+#include "vrdeform/metrics/latin_square.h"
+#include "vrdeform/study/study_analysis.h"
+#include "vrdeform/study/study_file.h"
+#include "vrdeform/study/study_simulation.h"
+
+namespace vrd {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The liver's poke (4.3 s with its release) under each condition, one trial each.
+constexpr const char* kStudy = R"(format = 1
+name = "poke"
+trials = 1
+[[condition]]
+name = "A"
+scene = "liver"
+[[condition]]
+name = "B"
+scene = "liver"
+force = "baseline"
+[[task]]
+name = "poke"
+seconds = 4.5
+[[question]]
+id = "V1"
+dimension = "visual"
+text = "It looked soft."
+[[question]]
+id = "H1"
+dimension = "haptic"
+text = "The force grew as I pressed."
+[[question]]
+id = "H2"
+dimension = "haptic"
+text = "The force felt smooth."
+[[comparison]]
+id = "D1"
+text = "Which force felt more natural?"
+)";
+
+struct Folder {
+  fs::path path;
+  explicit Folder(const std::string& name) : path(fs::temp_directory_path() / ("vrdeform_study_sim_" + name)) {
+    fs::remove_all(path);
+  }
+  ~Folder() { fs::remove_all(path); }
+};
+
+std::string read(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+bool anyPartial(const fs::path& dir) {
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.path().filename().string().ends_with(".partial")) return true;
+  return false;
+}
+
+TEST(StudySimulation, FourParticipantsRunTheStudyInTheirOrders) {
+  const StudySpec study = parseStudy(kStudy, "poke.toml", ".");
+  Folder data("four");
+  for (std::size_t k = 1; k <= 4; ++k) {
+    StudyRunSettings s;
+    s.dataDir = data.path;
+    s.participant = k;
+    const StudyRunResult r = runSimulatedParticipant(study, s);
+    EXPECT_EQ(r.trialsRun, 2u);
+    EXPECT_EQ(r.trialsKept, 0u);
+    const nlohmann::json who = nlohmann::json::parse(read(data.path / ("P" + std::to_string(k)) / "participant.json"));
+    const std::vector<std::size_t> order = latinSquareOrder(2, k - 1);
+    ASSERT_EQ(who["order"].size(), 2u);
+    for (std::size_t pos = 0; pos < 2; ++pos) {
+      EXPECT_EQ(who["order"][pos], study.conditions[order[pos]].name) << "P" << k << " position " << pos + 1;
+      const nlohmann::json trial = nlohmann::json::parse(
+          read(data.path / ("P" + std::to_string(k)) / "trials" / (std::to_string(pos + 1) + "-1-1") / "trial.json"));
+      EXPECT_EQ(trial["condition"], study.conditions[order[pos]].name);
+    }
+  }
+  EXPECT_FALSE(anyPartial(data.path));
+  const std::vector<ParticipantAnswers> people = readStudyAnswers(study, data.path);
+  ASSERT_EQ(people.size(), 4u);
+  for (const ParticipantAnswers& p : people) {
+    for (const auto& condition : p.answers)
+      for (const auto& answer : condition) EXPECT_TRUE(answer.has_value()) << p.id;
+    EXPECT_TRUE(p.comparisons[0].has_value()) << p.id;
+  }
+  // What was felt decides the felt items: A's force rises with the indentation, B's baseline is
+  // flat while loading (a step), so every participant rates the haptic dimension higher under A.
+  const StudyAnalysis a = analyseStudy(study, people);
+  const Measure& haptic = a.measures[4];  // V1, H1, H2, then the dimensions visual and haptic
+  ASSERT_EQ(haptic.name, "haptic");
+  for (std::size_t k = 0; k < 4; ++k) EXPECT_GT(*haptic.byCondition[0][k], *haptic.byCondition[1][k]) << "P" << k + 1;
+  EXPECT_LT(a.comparisons[0].mean, 0.0) << "D1 favours A";
+}
+
+TEST(StudySimulation, AStoppedRunResumesKeepingEveryFinishedTrial) {
+  const StudySpec study = parseStudy(kStudy, "poke.toml", ".");
+  Folder data("resumed"), whole("whole");
+  StudyRunSettings s;
+  s.dataDir = data.path;
+  s.participant = 2;
+  int trialsLogged = 0, polls = 0;
+  s.log = [&](const std::string&) { ++trialsLogged; };
+  s.stop = [&] { return trialsLogged >= 1 && ++polls > 100; };  // part-way into the second trial
+  EXPECT_THROW(runSimulatedParticipant(study, s), Stopped);
+  const fs::path first = data.path / "P2" / "trials" / "1-1-1";
+  ASSERT_TRUE(fs::is_regular_file(first / "trial.json"));
+  EXPECT_FALSE(fs::exists(data.path / "P2" / "trials" / "2-1-1"));
+  EXPECT_FALSE(anyPartial(data.path));
+  EXPECT_FALSE(fs::exists(data.path / "P2" / "answers.csv"));
+  const std::string kept = read(first / "trial.json");
+  const fs::file_time_type keptTime = fs::last_write_time(first / "trial.json");
+
+  s.stop = nullptr;
+  const StudyRunResult r = runSimulatedParticipant(study, s);
+  EXPECT_EQ(r.trialsKept, 1u);
+  EXPECT_EQ(r.trialsRun, 1u);
+  EXPECT_EQ(read(first / "trial.json"), kept);
+  EXPECT_EQ(fs::last_write_time(first / "trial.json"), keptTime);
+
+  s.dataDir = whole.path;  // the same participant in one go answers the same
+  runSimulatedParticipant(study, s);
+  EXPECT_EQ(read(data.path / "P2" / "answers.csv"), read(whole.path / "P2" / "answers.csv"));
+  EXPECT_EQ(read(data.path / "P2" / "comparisons.csv"), read(whole.path / "P2" / "comparisons.csv"));
+
+  fs::remove(first / "trial.json");  // a broken record is named, not run over
+  {
+    std::ofstream(first / "trial.json") << "{\"felt\": 1}";
+  }
+  try {
+    runSimulatedParticipant(study, s = StudyRunSettings{data.path, 2, {}, nullptr, nullptr});
+    ADD_FAILURE() << "a broken trial record should be refused";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not a finished trial's record"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace vrd
