@@ -82,7 +82,7 @@ struct Traces {
 class RunFiles {
  public:
   RunFiles(const BuiltScene& scene, const fs::path& dir, const std::array<bool, kFingerCount>& fingers)
-      : dir_(dir), fingers_(fingers) {
+      : dir_(dir), fingers_(fingers), plots_(scene.spec.output.plots) {
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec) throw Error(fmt::format("{}: cannot create the folder: {}", dir.string(), ec.message()));
@@ -143,6 +143,7 @@ class RunFiles {
     writeFile(dir_ / "latency.csv", latencyCsv(summary.latency));
     files.push_back("latency.csv");
     for (const Meshes& m : meshes_) files.push_back(fs::path("meshes") / m.file);
+    if (!plots_) return;
 
     Plot overTime{fmt::format("{}: haptic force", summary.scene), "time (s)", "force (normalised)", {}, {{0.0, 1.0}}};
     for (int f = 0; f < kFingerCount; ++f)
@@ -173,6 +174,7 @@ class RunFiles {
   };
   fs::path dir_;
   std::array<bool, kFingerCount> fingers_;
+  bool plots_;
   std::optional<CsvRecorder> forces_;
   std::optional<fmt::ostream> stageCsv_;  // written as the steps are made
   std::uint64_t meshEvery_ = 0;

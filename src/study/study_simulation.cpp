@@ -34,10 +34,11 @@ Felt feltInTrial(const SceneSpec& spec, const std::vector<double>& depth, const 
     const std::size_t end = std::min(depth.size(), std::size_t(std::lround((a.action.end() + 0.3) / dt)));
     if (end <= begin) break;
     const std::size_t holdBegin = std::size_t(std::lround((a.action.start + a.action.approach) / dt)) - begin;
-    const std::size_t holdEnd = std::size_t(std::lround((a.action.start + a.action.approach + a.action.hold) / dt)) - begin;
-    const SignalQuality q = signalQuality(std::span(depth).subspan(begin, end - begin),
-                                          std::span(felt).subspan(begin, end - begin), holdBegin,
-                                          std::min(holdEnd, end - begin));
+    const std::size_t holdEnd =
+        std::size_t(std::lround((a.action.start + a.action.approach + a.action.hold) / dt)) - begin;
+    const SignalQuality q =
+        signalQuality(std::span(depth).subspan(begin, end - begin), std::span(felt).subspan(begin, end - begin),
+                      holdBegin, std::min(holdEnd, end - begin));
     Felt f;
     f.peak = q.peak;
     if (std::isfinite(q.roughness)) f.roughness = q.roughness;
@@ -64,8 +65,8 @@ double draw(const SimulatedParticipant& s, std::size_t participant, std::size_t 
 
 int clampRound(double v, int lo, int hi) { return std::clamp(int(std::lround(v)), lo, hi); }
 
-nlohmann::json runTrial(const StudyCondition& c, const StudyTask& task, int trial,
-                        const fs::path& dir, const StudyRunSettings& settings) {
+nlohmann::json runTrial(const StudyCondition& c, const StudyTask& task, int trial, const fs::path& dir,
+                        const StudyRunSettings& settings) {
   SceneSpec spec = loadSceneByName(c.scene);
   spec.output.meshEvery = 0.0;
   spec.output.plots = false;
@@ -93,13 +94,19 @@ nlohmann::json runTrial(const StudyCondition& c, const StudyTask& task, int tria
     throw Stopped(fmt::format("stopped during trial {} of {} in condition {}", trial, task.name, c.name));
   }
   const Felt f = feltInTrial(spec, depth, felt);
-  nlohmann::json j{{"condition", c.name}, {"task", task.name},   {"trial", trial},
-                   {"scene", c.scene},    {"steps", summary.steps}, {"felt_roughness", f.roughness},
-                   {"felt_spearman", f.spearman}, {"felt_peak", f.peak}};
+  nlohmann::json j{{"condition", c.name},
+                   {"task", task.name},
+                   {"trial", trial},
+                   {"scene", c.scene},
+                   {"steps", summary.steps},
+                   {"felt_roughness", f.roughness},
+                   {"felt_spearman", f.spearman},
+                   {"felt_peak", f.peak}};
   writeFile(partial / "trial.json", j.dump(2) + "\n");
   std::error_code error;
   fs::rename(partial, dir, error);  // the finished trial appears whole
-  if (error) throw Error(fmt::format("{}: cannot move the finished trial into place: {}", dir.string(), error.message()));
+  if (error)
+    throw Error(fmt::format("{}: cannot move the finished trial into place: {}", dir.string(), error.message()));
   return j;
 }
 
@@ -108,8 +115,8 @@ nlohmann::json readTrial(const fs::path& file) {
   nlohmann::json j = nlohmann::json::parse(io::readFileBytes(file), nullptr, false);
   if (!j.is_object() || !j.contains("felt_roughness") || !j["felt_roughness"].is_number() ||
       !j.contains("felt_spearman") || !j["felt_spearman"].is_number())
-    throw Error(fmt::format("{}: not a finished trial's record; delete its folder to run the trial again",
-                            file.string()));
+    throw Error(
+        fmt::format("{}: not a finished trial's record; delete its folder to run the trial again", file.string()));
   return j;
 }
 
@@ -137,9 +144,10 @@ StudyRunResult runSimulatedParticipant(const StudySpec& study, const StudyRunSet
           j = runTrial(c, study.tasks[t], r, dir, settings);
           ++result.trialsRun;
           if (settings.log)
-            settings.log(fmt::format("P{}: condition {} ({} of {}), {} trial {}: felt roughness {:.2f}, Spearman {:.3f}",
-                                     settings.participant, c.name, pos + 1, order.size(), study.tasks[t].name, r,
-                                     j["felt_roughness"].get<double>(), j["felt_spearman"].get<double>()));
+            settings.log(
+                fmt::format("P{}: condition {} ({} of {}), {} trial {}: felt roughness {:.2f}, Spearman {:.3f}",
+                            settings.participant, c.name, pos + 1, order.size(), study.tasks[t].name, r,
+                            j["felt_roughness"].get<double>(), j["felt_spearman"].get<double>()));
         }
         sum += feltScore({j["felt_roughness"].get<double>(), j["felt_spearman"].get<double>(), 0.0}, study.points);
         ++count;
@@ -161,8 +169,8 @@ StudyRunResult runSimulatedParticipant(const StudySpec& study, const StudyRunSet
     const StudyComparison& x = study.comparisons[d];
     const double model = score[x.b] - score[x.a];  // negative: the first felt better
     comparisons += fmt::format("{},{}\n", x.id,
-                               clampRound(model + draw(settings.simulated, settings.participant, study.conditions.size(),
-                                                       study.questions.size() + d),
+                               clampRound(model + draw(settings.simulated, settings.participant,
+                                                       study.conditions.size(), study.questions.size() + d),
                                           -study.comparisonRange, study.comparisonRange));
   }
   nlohmann::json who{{"participant", fmt::format("P{}", settings.participant)},

@@ -328,6 +328,7 @@ TEST(SceneRun, WritesEveryOutputAndASummaryWithTheDocumentedKeys) {
   EXPECT_EQ(j["scene"], "liver");
   EXPECT_EQ(j["steps"], 150);
   EXPECT_EQ(j["ok"], true);
+
   EXPECT_EQ(j["tets"], r.tets);
   EXPECT_EQ(j["constraints"]["volume"], r.tets);
   EXPECT_EQ(j["constraints"]["shape_matching"], 1);
@@ -346,6 +347,17 @@ TEST(SceneRun, WritesEveryOutputAndASummaryWithTheDocumentedKeys) {
     EXPECT_TRUE(line.starts_with(std::to_string(rows) + ",")) << "row " << rows << ": " << line;
   }
   EXPECT_EQ(rows, 150u);
+
+  // [output] plots = false, mesh_every = 0: the per-step files and the summary only.
+  spec.output.meshEvery = 0.0;
+  spec.output.plots = false;
+  BuiltScene bare = buildScene(spec);
+  settings.outDir = dir.path() / "bare";
+  settings.steps = 10;
+  runScene(bare, settings);
+  EXPECT_TRUE(std::filesystem::is_regular_file(settings.outDir / "forces.csv"));
+  for (const char* f : {"force_time.svg", "force_indentation.svg", "meshes"})
+    EXPECT_FALSE(std::filesystem::exists(settings.outDir / f)) << f;
 }
 
 TEST(SceneRun, WritesClothAndRenderMeshesToo) {

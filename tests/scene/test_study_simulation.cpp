@@ -137,9 +137,7 @@ TEST(StudySimulation, AStoppedRunResumesKeepingEveryFinishedTrial) {
   EXPECT_EQ(read(data.path / "P2" / "comparisons.csv"), read(whole.path / "P2" / "comparisons.csv"));
 
   fs::remove(first / "trial.json");  // a broken record is named, not run over
-  {
-    std::ofstream(first / "trial.json") << "{\"felt\": 1}";
-  }
+  { std::ofstream(first / "trial.json") << "{\"felt\": 1}"; }
   try {
     runSimulatedParticipant(study, s = StudyRunSettings{data.path, 2, {}, nullptr, nullptr});
     ADD_FAILURE() << "a broken trial record should be refused";
