@@ -4,15 +4,15 @@
 #include <cmath>
 
 namespace vrd {
-namespace {
 
-/// Type-7 percentile of sorted, non-empty `x` at fraction `p` (see summarise()).
-double percentile(const std::vector<double>& x, double p) {
+double percentileOfSorted(std::span<const double> x, double p) {
   const double h = double(x.size() - 1) * p;
   const std::size_t lo = std::size_t(h);
   if (lo + 1 >= x.size()) return x.back();
   return x[lo] + (h - double(lo)) * (x[lo + 1] - x[lo]);
 }
+
+namespace {
 
 /// summarise() on a vector it may reorder.
 SampleStats summariseInPlace(std::vector<double>& x) {
@@ -29,9 +29,9 @@ SampleStats summariseInPlace(std::vector<double>& x) {
   for (double v : x) squares += (v - s.mean) * (v - s.mean);
   s.count = x.size();
   s.stddev = std::sqrt(squares / n);
-  s.median = percentile(x, 0.50);
-  s.p95 = percentile(x, 0.95);
-  s.p99 = percentile(x, 0.99);
+  s.median = percentileOfSorted(x, 0.50);
+  s.p95 = percentileOfSorted(x, 0.95);
+  s.p99 = percentileOfSorted(x, 0.99);
   s.min = x.front();
   s.max = x.back();
   return s;

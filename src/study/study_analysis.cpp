@@ -12,6 +12,8 @@
 #include "vrdeform/core/text_tokens.h"
 #include "vrdeform/core/write_file.h"
 #include "vrdeform/error.h"
+#include "vrdeform/io/svg_chart.h"
+#include "vrdeform/metrics/sample_stats.h"
 
 namespace vrd {
 namespace {
@@ -124,14 +126,6 @@ ParticipantAnswers readParticipant(const StudySpec& study, const fs::path& dir, 
   return p;
 }
 
-// Hyndman-Fan type 7 on sorted values.
-double quantile(const std::vector<double>& sorted, double p) {
-  const double h = double(sorted.size() - 1) * p;
-  const std::size_t lo = std::size_t(std::floor(h));
-  const std::size_t hi = std::min(lo + 1, sorted.size() - 1);
-  return sorted[lo] + (h - double(lo)) * (sorted[hi] - sorted[lo]);
-}
-
 // Participants with a value in both `a` and `b`, as two paired lists.
 PairedTest pairedTest(const std::string& measure, bool dimension, std::size_t ia, std::size_t ib,
                       const std::vector<std::optional<double>>& a, const std::vector<std::optional<double>>& b) {
@@ -162,9 +156,9 @@ Description describe(std::vector<double> values) {
   double squares = 0;
   for (double v : values) squares += (v - d.mean) * (v - d.mean);
   d.sd = d.n > 1 ? std::sqrt(squares / double(d.n - 1)) : std::nan("");
-  d.median = quantile(values, 0.5);
-  d.q1 = quantile(values, 0.25);
-  d.q3 = quantile(values, 0.75);
+  d.median = percentileOfSorted(values, 0.5);
+  d.q1 = percentileOfSorted(values, 0.25);
+  d.q3 = percentileOfSorted(values, 0.75);
   return d;
 }
 
@@ -303,6 +297,60 @@ void writeStudyAnalysis(const StudySpec& study, const std::vector<ParticipantAns
   }
   writeFile(outDir / "comparisons.csv", comparisons);
 
+  // The paper's figures: the dimensions' box plots per condition, the comparisons' ratings, and each
+  // item's mean difference between the conditions of every pair.
+  BoxPlot dims{study.name + ": dimensions", fmt::format("rating (1-{})", study.points), {}, {}, {},
+               {1.0, double(study.points)}};
+  for (std::size_t c = 0; c < nc; ++c) dims.series.push_back(conditionName(c));
+  for (const Measure& m : analysis.measures)
+    if (m.dimension) {
+      dims.groups.push_back(m.name);
+      auto& groupValues = dims.values.emplace_back();
+      for (std::size_t c = 0; c < nc; ++c) {
+        auto& box = groupValues.emplace_back();
+        for (const std::optional<double>& v : m.byCondition[c])
+          if (v) box.push_back(*v);
+      }
+    }
+  writeFile(outDir / "dimensions.svg", svgBoxPlot(dims));
+  if (!study.comparisons.empty()) {
+    BoxPlot ratings{study.name + ": direct comparisons (negative favours the first condition)",
+                    "rating",
+                    {"rating"},
+                    {},
+                    {},
+                    {-double(study.comparisonRange), double(study.comparisonRange)}};
+    for (std::size_t d = 0; d < study.comparisons.size(); ++d) {
+      ratings.groups.push_back(study.comparisons[d].id);
+      std::vector<double> box;
+      for (const ParticipantAnswers& p : participants)
+        if (p.comparisons[d]) box.push_back(*p.comparisons[d]);
+      ratings.values.push_back({box});
+    }
+    writeFile(outDir / "comparisons.svg", svgBoxPlot(ratings));
+  }
+  Heatmap heat{study.name + ": mean difference per item", {}, {}, {}, 1.0};
+  for (std::size_t a = 0; a < nc; ++a)
+    for (std::size_t b = a + 1; b < nc; ++b) heat.columns.push_back(conditionName(a) + " - " + conditionName(b));
+  for (const Measure& m : analysis.measures) {
+    if (m.dimension) continue;
+    heat.rows.push_back(m.name);
+    auto& row = heat.values.emplace_back();
+    for (std::size_t a = 0; a < nc; ++a)
+      for (std::size_t b = a + 1; b < nc; ++b) {
+        double sum = 0;
+        int n = 0;
+        for (std::size_t k = 0; k < participants.size(); ++k)
+          if (m.byCondition[a][k] && m.byCondition[b][k]) {
+            sum += *m.byCondition[a][k] - *m.byCondition[b][k];
+            ++n;
+          }
+        row.push_back(n > 0 ? sum / n : std::nan(""));
+        if (n > 0) heat.range = std::max(heat.range, std::ceil(std::abs(sum / n)));
+      }
+  }
+  writeFile(outDir / "items.svg", svgHeatmap(heat));
+
   // The report: the dimensions first (the paper's figures), then every item, the order, the comparisons.
   std::vector<std::string_view> names;
   for (const StudyCondition& c : study.conditions) names.push_back(c.name);
@@ -338,7 +386,7 @@ void writeStudyAnalysis(const StudySpec& study, const std::vector<ParticipantAns
   if (!study.comparisons.empty()) {
     md += fmt::format(
         "\n## Direct comparisons\n\nRated on -{0}..{0}: negative favours the first condition, 0 no "
-        "difference, positive the second; Wilcoxon signed-rank against 0.\n\n"
+        "difference, positive the second; Wilcoxon signed-rank against 0.\n\n![comparisons](comparisons.svg)\n\n"
         "| item | question | conditions | n | mean | median | IQR | p |\n|---|---|---|---:|---:|---:|---|---:|\n",
         study.comparisonRange);
     for (std::size_t d = 0; d < study.comparisons.size(); ++d) {
@@ -349,7 +397,9 @@ void writeStudyAnalysis(const StudySpec& study, const std::vector<ParticipantAns
                         analysis.comparisonTests[d].result.p);
     }
   }
-  md += "\nFiles: tidy.csv (one row per answer), descriptive.csv, tests.csv, order.csv, comparisons.csv.\n";
+  md +=
+      "\nFiles: tidy.csv (one row per answer), descriptive.csv, tests.csv, order.csv, comparisons.csv; the "
+      "figures dimensions.svg, items.svg and comparisons.svg.\n";
   writeFile(outDir / "report.md", md);
 }
 

@@ -30,6 +30,9 @@ struct SampleStats {
 /// So 1..100 gives median 50.5, P95 95.05, P99 99.01.
 SampleStats summarise(std::span<const double> samples);
 
+/// The p-th percentile (p in [0, 1]) of sorted, non-empty samples, as summarise() reads them (type 7).
+double percentileOfSorted(std::span<const double> sorted, double p);
+
 /// Exactly summarise() of the samples while fewer than kExactSamples were added; from then on
 /// count, mean, deviation, minimum and maximum from running sums (Welford's), and percentiles from
 /// a histogram of kBucketsPerOctave buckets per factor of two over [kLowest, kHighest], which puts
