@@ -37,9 +37,10 @@ std::string svgBoxPlot(const BoxPlot& plot, int width, int height) {
   std::string svg = header(width, height, plot.title);
   for (int k = 0; k <= 6; ++k) {  // grid lines and labels at seven even steps of the scale
     const double v = lo + (hi - lo) * k / 6.0;
-    svg += fmt::format("<line x1=\"{}\" x2=\"{}\" y1=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#ddd\"/>\n"
-                       "<text x=\"{}\" y=\"{:.1f}\" text-anchor=\"end\">{:g}</text>\n",
-                       left, right, y(v), y(v), left - 6, y(v) + 4, std::round(v * 100) / 100);
+    svg += fmt::format(
+        "<line x1=\"{}\" x2=\"{}\" y1=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#ddd\"/>\n"
+        "<text x=\"{}\" y=\"{:.1f}\" text-anchor=\"end\">{:g}</text>\n",
+        left, right, y(v), y(v), left - 6, y(v) + 4, std::round(v * 100) / 100);
   }
   svg += fmt::format("<text transform=\"translate(16 {:.1f}) rotate(-90)\" text-anchor=\"middle\">{}</text>\n",
                      (top + bottom) / 2, escapeXml(plot.yLabel));
@@ -80,10 +81,11 @@ std::string svgBoxPlot(const BoxPlot& plot, int width, int height) {
     }
   }
   for (std::size_t s = 0; s < ns; ++s)
-    svg += fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"14\" height=\"14\" fill=\"{}\" fill-opacity=\"0.5\"/>"
-                       "<text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n",
-                       right + 16, top + 20.0 * double(s), kColours[s % std::size(kColours)], right + 36,
-                       top + 20.0 * double(s) + 12, escapeXml(plot.series[s]));
+    svg += fmt::format(
+        "<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"14\" height=\"14\" fill=\"{}\" fill-opacity=\"0.5\"/>"
+        "<text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n",
+        right + 16, top + 20.0 * double(s), kColours[s % std::size(kColours)], right + 36, top + 20.0 * double(s) + 12,
+        escapeXml(plot.series[s]));
   return svg + "</svg>\n";
 }
 

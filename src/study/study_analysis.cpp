@@ -6,8 +6,6 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 
 #include "vrdeform/core/text_tokens.h"
 #include "vrdeform/core/write_file.h"

@@ -33,12 +33,11 @@ Felt feltInTrial(const SceneSpec& spec, const std::vector<double>& depth, const 
     const std::size_t begin = std::size_t(std::lround(a.action.start / dt));
     const std::size_t end = std::min(depth.size(), std::size_t(std::lround((a.action.end() + 0.3) / dt)));
     if (end <= begin) break;
+    const std::size_t n = end - begin;  // signalQuality clamps the hold to a trial cut short
     const std::size_t holdBegin = std::size_t(std::lround((a.action.start + a.action.approach) / dt)) - begin;
-    const std::size_t holdEnd =
-        std::size_t(std::lround((a.action.start + a.action.approach + a.action.hold) / dt)) - begin;
+    const std::size_t holdEnd = holdBegin + std::size_t(std::lround(a.action.hold / dt));
     const SignalQuality q =
-        signalQuality(std::span(depth).subspan(begin, end - begin), std::span(felt).subspan(begin, end - begin),
-                      holdBegin, std::min(holdEnd, end - begin));
+        signalQuality(std::span(depth).subspan(begin, n), std::span(felt).subspan(begin, n), holdBegin, holdEnd);
     Felt f;
     f.peak = q.peak;
     if (std::isfinite(q.roughness)) f.roughness = q.roughness;
@@ -77,20 +76,23 @@ nlohmann::json runTrial(const StudyCondition& c, const StudyTask& task, int tria
   RunSettings run;
   run.steps = std::uint64_t(std::lround(seconds / spec.solver.timeStep));
   const fs::path partial = dir.parent_path() / (dir.filename().string() + ".partial");
-  fs::remove_all(partial);
+  std::error_code error;
+  fs::remove_all(partial, error);  // what a killed run left
   run.outDir = partial;
   std::vector<double> depth, felt;
   bool stopped = false;
   run.afterStep = [&](const RunStep& s) {
-    const FingerHaptics& f = s.session->haptics().fingers[int(Finger::Index)];
-    depth.push_back(f.depth);
-    felt.push_back(c.force == StudyForce::Baseline ? f.baseline : f.force);
+    if (s.session) {  // a scene without a hand: nothing felt
+      const FingerHaptics& f = s.session->haptics().fingers[int(Finger::Index)];
+      depth.push_back(f.depth);
+      felt.push_back(c.force == StudyForce::Baseline ? f.baseline : f.force);
+    }
     stopped = settings.stop && settings.stop();
     return !stopped;
   };
   const RunSummary summary = runScene(scene, run);
   if (stopped) {
-    fs::remove_all(partial);
+    fs::remove_all(partial, error);
     throw Stopped(fmt::format("stopped during trial {} of {} in condition {}", trial, task.name, c.name));
   }
   const Felt f = feltInTrial(spec, depth, felt);
@@ -103,7 +105,6 @@ nlohmann::json runTrial(const StudyCondition& c, const StudyTask& task, int tria
                    {"felt_spearman", f.spearman},
                    {"felt_peak", f.peak}};
   writeFile(partial / "trial.json", j.dump(2) + "\n");
-  std::error_code error;
   fs::rename(partial, dir, error);  // the finished trial appears whole
   if (error)
     throw Error(fmt::format("{}: cannot move the finished trial into place: {}", dir.string(), error.message()));

@@ -39,9 +39,9 @@ TEST(SvgChart, HeatmapColoursDivergeFromWhite) {
   const Heatmap h{"items", {"H1", "H2", "H3", "H4"}, {"A - B"}, {{2.0}, {-2.0}, {0.0}, {std::nan("")}}, 2.0};
   const std::string svg = svgHeatmap(h);
   EXPECT_NE(svg.find("data-row=\"H1\" data-column=\"A - B\" data-value=\"2.00\""), std::string::npos);
-  EXPECT_NE(svg.find("fill=\"#ff0000\""), std::string::npos);  // +range: red
-  EXPECT_NE(svg.find("fill=\"#0000ff\""), std::string::npos);  // -range: blue
-  EXPECT_NE(svg.find("fill=\"#ffffff\""), std::string::npos);  // 0: white
+  EXPECT_NE(svg.find("fill=\"#ff0000\""), std::string::npos);                                        // +range: red
+  EXPECT_NE(svg.find("fill=\"#0000ff\""), std::string::npos);                                        // -range: blue
+  EXPECT_NE(svg.find("fill=\"#ffffff\""), std::string::npos);                                        // 0: white
   EXPECT_NE(svg.find("data-row=\"H4\" data-column=\"A - B\" data-value=\"-\""), std::string::npos);  // NaN
   EXPECT_THROW(svgHeatmap({"x", {"H1"}, {"A - B"}, {{1.0, 2.0}}, 1.0}), Error);
   EXPECT_THROW(svgHeatmap({"x", {"H1"}, {"A - B"}, {{1.0}}, 0.0}), Error);
