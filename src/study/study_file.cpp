@@ -41,6 +41,14 @@ void checkUnique(const Field& f, const std::string& name, std::vector<std::strin
   seen.push_back(name);
 }
 
+// The CSV name `key` of table `t`, unique within `seen` (which it extends).
+std::string uniqueCsvName(const Table& t, std::string_view key, std::vector<std::string>& seen) {
+  const Field f = t.require(key);
+  std::string name = csvName(f);
+  checkUnique(f, name, seen, key);
+  return name;
+}
+
 StudySpec readStudy(const Table& root) {
   root.allowOnly({"format", "name", "description", "trials", "rest", "points", "comparison_range", "order", "condition",
                   "task", "question", "comparison"});
@@ -61,9 +69,7 @@ StudySpec readStudy(const Table& root) {
   for (const Table& t : root.tables("condition")) {
     t.allowOnly({"name", "scene", "force"});
     StudyCondition c;
-    const Field name = t.require("name");
-    c.name = csvName(name);
-    checkUnique(name, c.name, names, "name");
+    c.name = uniqueCsvName(t, "name", names);
     c.scene = readSceneName(t.require("scene"));
     constexpr Option<StudyForce> kForces[] = {{"multipliers", StudyForce::Multipliers},
                                               {"baseline", StudyForce::Baseline}};
@@ -89,9 +95,7 @@ StudySpec readStudy(const Table& root) {
   for (const Table& t : root.tables("question")) {
     t.allowOnly({"id", "dimension", "text", "anchors"});
     StudyQuestion q;
-    const Field id = t.require("id");
-    q.id = csvName(id);
-    checkUnique(id, q.id, ids, "id");
+    q.id = uniqueCsvName(t, "id", ids);
     q.dimension = csvName(t.require("dimension"));
     q.text = t.require("text").name();
     if (const std::optional<Field> f = t.get("anchors")) {
@@ -106,9 +110,7 @@ StudySpec readStudy(const Table& root) {
   for (const Table& t : root.tables("comparison")) {
     t.allowOnly({"id", "text", "between"});
     StudyComparison c;
-    const Field id = t.require("id");
-    c.id = csvName(id);
-    checkUnique(id, c.id, ids, "id");
+    c.id = uniqueCsvName(t, "id", ids);
     c.text = t.require("text").name();
     if (const std::optional<Field> f = t.get("between")) {
       const std::vector<Field> pair = f->elements("an array of two condition names");
