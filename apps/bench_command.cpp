@@ -1,19 +1,25 @@
 #include "bench_command.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <ranges>
 #include <string>
 #include <thread>
+#include <tuple>
+#include <vector>
 
 #include "build_observer.h"
+#include "vrdeform/devices/glove_link.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
 #include "vrdeform/mesh/primitives.h"
@@ -21,6 +27,7 @@
 #include "vrdeform/scene/scene_library.h"
 #include "vrdeform/scene/scene_run.h"
 #include "vrdeform/scene/simulation_loop.h"
+#include "vrdeform/testing/fake_middleware.h"
 
 namespace vrd {
 namespace {
@@ -33,6 +40,7 @@ struct BenchArgs {
   bool quick = false;                    // skips the 100k-tet scaling row
   bool smoke = false;                    // every table at its smallest: checks the command, measures nothing
   SimdLevel simd = SimdLevel::Best;      // the lanes of every SIMD figure
+  std::vector<std::string> only;         // the parts to run (their JSON keys); empty: all
   const StopSignals* signals = nullptr;  // bench's, for Ctrl-C: each part's loops end early
 };
 
@@ -294,6 +302,134 @@ json loop(const BenchArgs& a, std::string& text) {
   return rows;
 }
 
+// Threads that spin until destroyed: the other programs of a VR machine (a compositor, a browser).
+class BusyNeighbours {
+ public:
+  explicit BusyNeighbours(int n) {
+    for (int k = 0; k < n; ++k)
+      threads_.emplace_back([this] {
+        volatile double x = 1.0;
+        while (!stop_.load(std::memory_order_relaxed)) x = x * 1.0000001 + 1e-9;
+      });
+  }
+  ~BusyNeighbours() {
+    stop_ = true;
+    for (std::thread& t : threads_) t.join();
+  }
+  BusyNeighbours(const BusyNeighbours&) = delete;
+  BusyNeighbours& operator=(const BusyNeighbours&) = delete;
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::vector<std::thread> threads_;
+};
+
+// Motion to force: the liver in the 1 kHz loop with its hand on a (fake) WEART glove. The index
+// presses for 30 ms of every 100 and is open otherwise; each press is timed from the tracking frame
+// that first shows it leaving the fake middleware to the first force frame for the index that rises,
+// as the fake receives it: the client, the loop's wait for its next step, the step and both loopback
+// hops. The open 70 ms let the smoothed force fall, so the first rise is the press's answer.
+struct MotionToForce {
+  SampleStats ms;  // per answered press
+  std::size_t unanswered = 0;
+  SampleStats stepMs;  // the loop's
+};
+
+MotionToForce motionToForceRun(BuiltScene& scene, double seconds, const BenchArgs& a) {
+  using Clock = std::chrono::steady_clock;
+  constexpr double kCycle = 0.1, kPress = 0.03;
+  std::vector<Clock::time_point> presses;  // written on the fake's thread until it stops
+  bool pressing = false;
+  weart::FakeMiddlewareSettings fs;
+  fs.tracking = [&](double t) {
+    const bool press = std::fmod(t, kCycle) < kPress;
+    if (press && !pressing) presses.push_back(Clock::now());
+    pressing = press;
+    std::array<float, kFingerCount> closure{};
+    closure[std::size_t(Finger::Index)] = press ? 0.5f : 0.0f;  // 0.5: half a fingertip radius deep
+    return closure;
+  };
+  weart::FakeMiddleware fake(fs);
+  fake.start();
+  const Vec3 point = scene.actions.empty() ? scene.bodies.front().top : scene.actions.front().target;
+  GloveLink glove(fmt::format("127.0.0.1:{}", fake.port()), scene.session.hand, point, [](std::string_view, bool) {});
+  for (const auto deadline = Clock::now() + std::chrono::seconds(5); !glove.closure(Finger::Index);)
+    if (Clock::now() > deadline || stopped(a))
+      throw Error("bench: the fake WEART middleware sent no tracking");
+    else
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+
+  SimulationLoopSettings ls;
+  ls.input = &glove.input();
+  ls.outputs = {&glove.output()};
+  SimulationLoop loop(scene, ls);
+  loop.start();
+  const Clock::time_point from = Clock::now() + std::chrono::milliseconds(200);  // past the first steps
+  const Clock::time_point until =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  while (Clock::now() < until && !stopped(a)) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  loop.stop();
+  glove.shutdown();
+  fake.stop();
+
+  std::vector<std::pair<Clock::time_point, float>> force;  // the index's force frames as received
+  for (const weart::ReceivedCommand& r : fake.commands())
+    if (r.command.point == weart::Point::Index && (r.command.kind == weart::ClientCommand::Kind::Force ||
+                                                   r.command.kind == weart::ClientCommand::Kind::StopForce))
+      force.emplace_back(r.time, r.command.kind == weart::ClientCommand::Kind::Force ? r.command.value : 0.0f);
+  MotionToForce out;
+  std::vector<double> ms;
+  for (const Clock::time_point press : presses) {
+    if (press < from || press > until - std::chrono::milliseconds(50)) continue;
+    auto next = std::find_if(force.begin(), force.end(), [&](const auto& f) { return f.first > press; });
+    const float before = next == force.begin() ? 0.0f : std::prev(next)->second;
+    next = std::find_if(next, force.end(), [&](const auto& f) { return f.second > before; });
+    if (next == force.end() || next->first - press > std::chrono::duration<double>(kPress))
+      ++out.unanswered;
+    else
+      ms.push_back(std::chrono::duration<double, std::milli>(next->first - press).count());
+  }
+  out.ms = summarise(ms);
+  out.stepMs = loop.stats().stepMs;
+  return out;
+}
+
+json motionToForce(const BenchArgs& a, std::string& text) {
+  const double seconds = a.smoke ? 0.3 : a.quick ? 3.0 : 10.0;
+  SceneSpec spec = benchScene("liver", a);
+  // At 1 kHz, substeps no longer than the scene's own (one, for the liver's 8 at 60 Hz).
+  const double substep = spec.solver.timeStep / spec.solver.substeps;
+  spec.solver.timeStep = 1e-3;
+  spec.solver.substeps = std::max(1, int(std::ceil(spec.solver.timeStep / substep - 1e-9)));
+  if (a.smoke) {
+    spec.settle = 0.05;
+    spec.haptics.calibrate = false;
+  }
+  BuiltScene scene = benchBuild(spec, a);
+  text += fmt::format(
+      "Motion to force: the liver at 1 kHz ({} x {}), its hand on a fake WEART glove (100 Hz tracking), the index "
+      "pressing: from the tracking frame leaving the fake middleware to the force frame that answers it arriving "
+      "there, ms (target P99 2.0), beside the loop's step\n"
+      "{:>11} | {:>7} {:>10} | {:>8} {:>8} {:>8} | {:>9} {:>8}\n",
+      spec.solver.substeps, spec.solver.iterations, "neighbours", "presses", "unanswered", "P50", "P99", "max",
+      "step P50", "P99");
+  json rows = json::array();
+  for (int neighbours : {0, 2}) {
+    if (a.smoke && neighbours > 0) continue;
+    const BusyNeighbours busy(neighbours);
+    const MotionToForce m = motionToForceRun(scene, seconds, a);
+    text += fmt::format("{:>11} | {:>7} {:>10} | {:8.3f} {:8.3f} {:8.3f} | {:9.3f} {:8.3f}\n", neighbours, m.ms.count,
+                        m.unanswered, m.ms.median, m.ms.p99, m.ms.max, m.stepMs.median, m.stepMs.p99);
+    rows.push_back({{"neighbours", neighbours},
+                    {"presses", m.ms.count},
+                    {"unanswered", m.unanswered},
+                    {"ms", {{"p50", m.ms.median}, {"p99", m.ms.p99}, {"max", m.ms.max}}},
+                    {"step_ms", {{"p50", m.stepMs.median}, {"p99", m.stepMs.p99}}}});
+  }
+  text += "  (neighbours: threads spinning beside it, as a compositor or a browser would)\n\n";
+  return rows;
+}
+
 // A block of tets resting on the ground in a world of its own.
 struct Block {
   std::unique_ptr<World> world;
@@ -397,28 +533,6 @@ Block cube(const SolverSettings& s) {
   return block(makeBoxTets(Vec3(-0.5f, 0.0f, -0.5f), Vec3::Ones(), 26, 26, 26), stiff, ConstraintSet::edgesAndVolume(),
                s);
 }
-
-// Threads that spin until destroyed: the other programs of a VR machine (a compositor, a browser).
-class BusyNeighbours {
- public:
-  explicit BusyNeighbours(int n) {
-    for (int k = 0; k < n; ++k)
-      threads_.emplace_back([this] {
-        volatile double x = 1.0;
-        while (!stop_.load(std::memory_order_relaxed)) x = x * 1.0000001 + 1e-9;
-      });
-  }
-  ~BusyNeighbours() {
-    stop_ = true;
-    for (std::thread& t : threads_) t.join();
-  }
-  BusyNeighbours(const BusyNeighbours&) = delete;
-  BusyNeighbours& operator=(const BusyNeighbours&) = delete;
-
- private:
-  std::atomic<bool> stop_{false};
-  std::vector<std::thread> threads_;
-};
 
 // Mean and 90th percentile of per-step times.
 std::pair<double, double> meanAndP90(std::vector<double> ms) {
@@ -603,10 +717,30 @@ int bench(BenchArgs a) {
   // Each part with its progress on stderr, so that it neither mixes with --json nor stays on a page
   // of results. Ctrl-C ends the part that runs early; what it measured is dropped, and the parts
   // done before it are printed.
-  constexpr int kParts = 9;
-  int part = 0;
-  const auto run = [&](const char* key, std::string_view what, auto&& measure) {
-    fmt::print(stderr, "bench [{}/{}] {}...\n", ++part, kParts, what);
+  using Measure = std::function<json()>;
+  const std::vector<std::tuple<const char*, std::string_view, Measure>> parts = {
+      {"table1", "Table 1: the paper's scenes", [&] { return table1(a, text); }},
+      {"table2", "Table 2: the flag", [&] { return table2(a, text); }},
+      {"table3", "Table 3: the liver's stages", [&] { return table3(a, text); }},
+      {"loop", "the real-time loop", [&] { return loop(a, text); }},
+      {"motion_to_force", "motion to force", [&] { return motionToForce(a, text); }},
+      {"scaling", "scaling", [&] { return scaling(a, text); }},
+      {"targets", "targets", [&] { return targets(a, j["table1"], text); }},
+      {"contention", "contention", [&] { return contention(a, text); }},
+      {"signal", "signal quality", [&] { return signalQualityTable(a, text); }},
+      {"convergence", "convergence", [&] { return convergence(a, text); }},
+  };
+  for (const std::string& key : a.only)
+    if (std::ranges::none_of(parts, [&](const auto& p) { return key == std::get<0>(p); }))
+      throw Error(
+          fmt::format("bench: --only: no part '{}' (the parts: {})", key,
+                      fmt::join(parts | std::views::transform([](const auto& p) { return std::get<0>(p); }), ", ")));
+  const auto chosen = [&](const char* key) { return a.only.empty() || std::ranges::count(a.only, key) > 0; };
+  const auto count = std::ranges::count_if(parts, [&](const auto& p) { return chosen(std::get<0>(p)); });
+  int done = 0;
+  for (const auto& [key, what, measure] : parts) {
+    if (!chosen(key)) continue;
+    fmt::print(stderr, "bench [{}/{}] {}...\n", done + 1, count, what);
     std::fflush(stderr);
     const std::string before = text;
     json result;
@@ -617,19 +751,11 @@ int bench(BenchArgs a) {
     if (stopped(a)) {
       text = before;
       print();
-      throw Stopped(fmt::format("bench: stopped during {} ({} of {} parts done)", what, part - 1, kParts));
+      throw Stopped(fmt::format("bench: stopped during {} ({} of {} parts done)", what, done, count));
     }
     j[key] = std::move(result);
-  };
-  run("table1", "Table 1: the paper's scenes", [&] { return table1(a, text); });
-  run("table2", "Table 2: the flag", [&] { return table2(a, text); });
-  run("table3", "Table 3: the liver's stages", [&] { return table3(a, text); });
-  run("loop", "the real-time loop", [&] { return loop(a, text); });
-  run("scaling", "scaling", [&] { return scaling(a, text); });
-  run("targets", "targets", [&] { return targets(a, j["table1"], text); });
-  run("contention", "contention", [&] { return contention(a, text); });
-  run("signal", "signal quality", [&] { return signalQualityTable(a, text); });
-  run("convergence", "convergence", [&] { return convergence(a, text); });
+    ++done;
+  }
   print();
   return 0;
 }
@@ -652,6 +778,7 @@ std::function<int()> addBenchCommand(CLI::App& app) {
       },
       "Every table at its smallest (2 frames, the loop for 0.05 s, 1k tets): checks that the command runs, "
       "measures nothing");
+  cmd->add_option("--only", a->only, "Run only these parts (keys of --json's output: table1, loop, signal, ...)");
   cmd->add_option_function<std::string>(
          "--simd",
          [a](const std::string& name) {

@@ -30,7 +30,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
 
-constexpr milliseconds kPollInterval{2};       // how soon the I/O thread sees a publish
+constexpr milliseconds kPollInterval{2};       // how often the I/O thread checks its timers and watchdog
 constexpr milliseconds kCloseFlushTime{1000};  // shutdown: time to write the stop frames
 constexpr milliseconds kCloseDrainTime{1000};  // shutdown: time for the middleware to close
 constexpr std::chrono::seconds kCalibrationTimeout{30};
@@ -737,10 +737,15 @@ void Client::publishForces(const std::array<float, kFingerCount>& force) {
     if (impl_->isThimble[p]) values[p] = clampUnit(force[std::size_t(f)]);
   }
   const Clock::time_point now = Clock::now();
-  std::lock_guard lock(impl_->desiredMutex);
-  impl_->desired.force = values;
-  impl_->desired.published = true;
-  impl_->desired.lastPublish = now;
+  bool changed = false;
+  {
+    std::lock_guard lock(impl_->desiredMutex);
+    changed = impl_->desired.force != values;
+    impl_->desired.force = values;
+    impl_->desired.published = true;
+    impl_->desired.lastPublish = now;
+  }
+  if (changed) impl_->wake.notify();  // the new force leaves now, not at the I/O thread's next poll
 }
 
 std::optional<std::array<float, kFingerCount>> Client::closures() const {

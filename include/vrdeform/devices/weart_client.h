@@ -98,8 +98,9 @@ class Client {
   void shutdown() noexcept;
 
   /// The force per finger, normalised to [0, 1] (clamped; NaN reads 0). Fingers whose point is not
-  /// among the thimbles are ignored. Call it every simulation step: the watchdog releases the glove
-  /// when it has not been called for `watchdog`.
+  /// among the thimbles are ignored. A changed force wakes the I/O thread, so its frame leaves at
+  /// once. Call it every simulation step: the watchdog releases the glove when it has not been
+  /// called for `watchdog`.
   void publishForces(const std::array<float, kFingerCount>& force);
   /// Latest closures of this hand's fingers in [0, 1]; fingers the glove does not track (ring and
   /// little on a G1) read 0. nullopt until the first tracking frame for this hand.
