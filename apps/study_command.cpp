@@ -50,7 +50,9 @@ int analyse(const StudyArgs& a) {
       fmt::print("{:<12} {} vs {}: {} pairs, W+ {}, p {:.4f}{}, r {:.2f}\n", t.measure, s.conditions[t.a].name,
                  s.conditions[t.b].name, t.pairs, t.result.wPlus, t.result.p, t.result.exact ? " (exact)" : "",
                  t.result.effectSize);
-  fmt::print("wrote {}/: report.md tidy.csv descriptive.csv tests.csv order.csv comparisons.csv\n", out);
+  fmt::print(
+      "wrote {}/: report.md tidy.csv descriptive.csv tests.csv order.csv comparisons.csv, figures as .svg and .png\n",
+      out);
   return 0;
 }
 

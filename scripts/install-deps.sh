@@ -24,6 +24,7 @@ packages=(
   chromium            # the VR page's browser test (headless, with an emulated headset)
   libepoxy-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri   # OpenGL renderer; headless on Mesa's EGL surfaceless
   libglfw3-dev libimgui-dev libstb-dev   # desktop viewer window and panels; PNG frames
+  librsvg2-dev        # the study report's figures as PNG beside their SVG
   xvfb xauth          # the viewer's test under a virtual X server
   ffmpeg              # MP4 from headless frames (vrdeform render; optional at run time)
   python3-dev pybind11-dev python3-numpy python3-pytest   # the Python module (python/) and its tests

@@ -11,6 +11,7 @@
 #include "vrdeform/core/write_file.h"
 #include "vrdeform/error.h"
 #include "vrdeform/io/svg_chart.h"
+#include "vrdeform/io/svg_raster.h"
 #include "vrdeform/metrics/sample_stats.h"
 
 namespace vrd {
@@ -137,6 +138,12 @@ PairedTest pairedTest(const std::string& measure, bool dimension, std::size_t ia
 }
 
 std::string number(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : std::string("NA"); }
+
+// A figure as SVG (for the web and further editing) and PNG (for slides and word processors).
+void writeFigure(const std::filesystem::path& stem, const std::string& svg) {
+  writeFile(stem.string() + ".svg", svg);
+  writeSvgAsPng(svg, stem.string() + ".png");
+}
 
 }  // namespace
 
@@ -310,7 +317,7 @@ void writeStudyAnalysis(const StudySpec& study, const std::vector<ParticipantAns
           if (v) box.push_back(*v);
       }
     }
-  writeFile(outDir / "dimensions.svg", svgBoxPlot(dims));
+  writeFigure(outDir / "dimensions", svgBoxPlot(dims));
   if (!study.comparisons.empty()) {
     BoxPlot ratings{study.name + ": direct comparisons (negative favours the first condition)",
                     "rating",
@@ -325,7 +332,7 @@ void writeStudyAnalysis(const StudySpec& study, const std::vector<ParticipantAns
         if (p.comparisons[d]) box.push_back(*p.comparisons[d]);
       ratings.values.push_back({box});
     }
-    writeFile(outDir / "comparisons.svg", svgBoxPlot(ratings));
+    writeFigure(outDir / "comparisons", svgBoxPlot(ratings));
   }
   Heatmap heat{study.name + ": mean difference per item", {}, {}, {}, 1.0};
   for (std::size_t a = 0; a < nc; ++a)
@@ -347,7 +354,7 @@ void writeStudyAnalysis(const StudySpec& study, const std::vector<ParticipantAns
         if (n > 0) heat.range = std::max(heat.range, std::ceil(std::abs(sum / n)));
       }
   }
-  writeFile(outDir / "items.svg", svgHeatmap(heat));
+  writeFigure(outDir / "items", svgHeatmap(heat));
 
   // The report: the dimensions first (the paper's figures), then every item, the order, the comparisons.
   std::vector<std::string_view> names;
@@ -397,7 +404,7 @@ void writeStudyAnalysis(const StudySpec& study, const std::vector<ParticipantAns
   }
   md +=
       "\nFiles: tidy.csv (one row per answer), descriptive.csv, tests.csv, order.csv, comparisons.csv; the "
-      "figures dimensions.svg, items.svg and comparisons.svg.\n";
+      "figures dimensions, items and comparisons, each as .svg and .png.\n";
   writeFile(outDir / "report.md", md);
 }
 

@@ -143,8 +143,9 @@ TEST(StudyAnalysis, DescribesAndTestsEveryItemAndDimension) {
   EXPECT_EQ(a.comparisonTests[0].result.wPlus, 0.0);
 
   writeStudyAnalysis(study, people, a, data.path / "out");
-  for (const char* f : {"tidy.csv", "descriptive.csv", "tests.csv", "order.csv", "comparisons.csv", "report.md",
-                        "dimensions.svg", "items.svg", "comparisons.svg"})
+  for (const char* f :
+       {"tidy.csv", "descriptive.csv", "tests.csv", "order.csv", "comparisons.csv", "report.md", "dimensions.svg",
+        "items.svg", "comparisons.svg", "dimensions.png", "items.png", "comparisons.png"})
     EXPECT_TRUE(fs::is_regular_file(data.path / "out" / f)) << f;
   std::ifstream tidy(data.path / "out" / "tidy.csv");
   std::string line;

@@ -71,10 +71,10 @@ struct StudyAnalysis {
 StudyAnalysis analyseStudy(const StudySpec& study, const std::vector<ParticipantAnswers>& participants);
 
 /// Writes tidy.csv (participant, position, condition, item, dimension, answer: one row per answer),
-/// descriptive.csv, tests.csv, order.csv, comparisons.csv, the figures dimensions.svg (box plots per
-/// dimension and condition), items.svg (each item's mean difference for every pair of conditions)
-/// and comparisons.svg (the direct comparisons' ratings), and report.md into `outDir`, each file
-/// complete or not at all. Throws vrd::Error.
+/// descriptive.csv, tests.csv, order.csv, comparisons.csv, the figures dimensions (box plots per
+/// dimension and condition), items (each item's mean difference for every pair of conditions) and
+/// comparisons (the direct comparisons' ratings), each as .svg and .png, and report.md into
+/// `outDir`, each file complete or not at all. Throws vrd::Error.
 void writeStudyAnalysis(const StudySpec& study, const std::vector<ParticipantAnswers>& participants,
                         const StudyAnalysis& analysis, const std::filesystem::path& outDir);
 
