@@ -68,12 +68,13 @@ std::string svgBoxPlot(const BoxPlot& plot, int width, int height) {
       svg += fmt::format(
           "<g class=\"box\" data-group=\"{}\" data-series=\"{}\" data-median=\"{:g}\" data-q1=\"{:g}\" "
           "data-q3=\"{:g}\">\n"
-          "<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#333\"/>\n"
+          "<line class=\"whisker\" x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#333\"/>\n"
+          "<line class=\"whisker\" x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#333\"/>\n"
           "<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"{}\" fill-opacity=\"0.5\" "
           "stroke=\"{}\"/>\n"
           "<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#000\" stroke-width=\"2\"/>\n",
-          escapeXml(plot.groups[g]), escapeXml(plot.series[s]), median, q1, q3, xm, xm, y(high), y(low), xl, y(q3),
-          xr - xl, std::max(0.5, y(q1) - y(q3)), colour, colour, xl, xr, y(median), y(median));
+          escapeXml(plot.groups[g]), escapeXml(plot.series[s]), median, q1, q3, xm, xm, y(high), y(q3), xm, xm, y(q1),
+          y(low), xl, y(q3), xr - xl, std::max(0.5, y(q1) - y(q3)), colour, colour, xl, xr, y(median), y(median));
       for (double x : v)
         if (x < low || x > high)
           svg += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"2.5\" fill=\"{}\"/>\n", xm, y(x), colour);

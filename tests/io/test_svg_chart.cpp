@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <regex>
 #include <string>
 
 #include "vrdeform/error.h"
@@ -26,7 +27,22 @@ TEST(SvgChart, BoxesSitAtTheQuartilesWithTukeysOutliers) {
   EXPECT_NE(svg.find("data-series=\"B\" data-median=\"2\" data-q1=\"2\" data-q3=\"2\""), std::string::npos);
   EXPECT_EQ(count(svg, "<circle"), 1u);
   EXPECT_EQ(count(svg, "class=\"box\""), 2u);
-  p.values[0][1] = {std::nan(""), 3.0};  // non-finite samples left out
+  // Whiskers from the box's edges outwards, not through the box: for A, the upper one from y(5) to
+  // the box's top y(4) and the lower one from its bottom y(2) to y(1).
+  const std::regex box(
+      "data-series=\"A\"[^>]*>\\n"
+      "<line class=\"whisker\"[^>]* y1=\"([0-9.]+)\" y2=\"([0-9.]+)\"[^>]*>\\n"
+      "<line class=\"whisker\"[^>]* y1=\"([0-9.]+)\" y2=\"([0-9.]+)\"[^>]*>\\n"
+      "<rect x=\"[0-9.]+\" y=\"([0-9.]+)\" width=\"[0-9.]+\" height=\"([0-9.]+)\"");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(svg, m, box));
+  const double top = std::stod(m[5]), bottom = top + std::stod(m[6]);
+  EXPECT_LT(std::stod(m[1]), top);  // y grows downwards: 5 above the box
+  EXPECT_DOUBLE_EQ(std::stod(m[2]), top);
+  EXPECT_DOUBLE_EQ(std::stod(m[3]), bottom);
+  EXPECT_GT(std::stod(m[4]), bottom);                                  // 1 below it
+  EXPECT_NEAR(std::stod(m[1]) - top, bottom - std::stod(m[4]), 0.11);  // one unit of the scale each
+  p.values[0][1] = {std::nan(""), 3.0};                                // non-finite samples left out
   EXPECT_NE(svgBoxPlot(p).find("data-series=\"B\" data-median=\"3\""), std::string::npos);
   p.values[0].pop_back();
   EXPECT_THROW(svgBoxPlot(p), Error);

@@ -21,7 +21,8 @@ struct Png {
   int width() const { return cairo_image_surface_get_width(surface.get()); }
   int height() const { return cairo_image_surface_get_height(surface.get()); }
   std::uint32_t argb(int x, int y) const {  // cairo's ARGB32, premultiplied: opaque pixels as written
-    const unsigned char* row = cairo_image_surface_get_data(surface.get()) + y * cairo_image_surface_get_stride(surface.get());
+    const unsigned char* row =
+        cairo_image_surface_get_data(surface.get()) + y * cairo_image_surface_get_stride(surface.get());
     return reinterpret_cast<const std::uint32_t*>(row)[x];
   }
 };
@@ -44,10 +45,10 @@ TEST(SvgRaster, DrawsTheShapesWhereTheSvgPutsThemAtTwiceItsSize) {
   const Png png = readPng(dir / "shapes.png");
   ASSERT_EQ(png.width(), 200);
   ASSERT_EQ(png.height(), 100);
-  EXPECT_EQ(png.argb(40, 40), 0xffff0000u);    // inside the red square (20-60 px)
-  EXPECT_EQ(png.argb(150, 60), 0xff0000ffu);   // inside the blue one (120-180, 40-80 px)
-  EXPECT_EQ(png.argb(100, 20), 0xffffffffu);   // between them: the white background
-  EXPECT_EQ(png.argb(61, 40), 0xffffffffu);    // just right of the red square's edge at 60 px
+  EXPECT_EQ(png.argb(40, 40), 0xffff0000u);   // inside the red square (20-60 px)
+  EXPECT_EQ(png.argb(150, 60), 0xff0000ffu);  // inside the blue one (120-180, 40-80 px)
+  EXPECT_EQ(png.argb(100, 20), 0xffffffffu);  // between them: the white background
+  EXPECT_EQ(png.argb(61, 40), 0xffffffffu);   // just right of the red square's edge at 60 px
 }
 
 TEST(SvgRaster, AChartKeepsItsTextAndBoxes) {
@@ -71,8 +72,9 @@ TEST(SvgRaster, AChartKeepsItsTextAndBoxes) {
 
 TEST(SvgRaster, WhatIsNotAnSvgDrawingIsRefusedAndNothingWritten) {
   const testing::TempDir dir;
-  for (const std::string& bad : {std::string("not xml at all"), std::string("<svg xmlns=\"http://www.w3.org/2000/svg\""),
-                                 std::string("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"0\" height=\"0\"/>")}) {
+  for (const std::string& bad :
+       {std::string("not xml at all"), std::string("<svg xmlns=\"http://www.w3.org/2000/svg\""),
+        std::string("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"0\" height=\"0\"/>")}) {
     try {
       writeSvgAsPng(bad, dir / "bad.png");
       ADD_FAILURE() << "accepted: " << bad;
