@@ -354,11 +354,11 @@ MotionToForce motionToForceRun(BuiltScene& scene, double seconds, const BenchArg
   fake.start();
   const Vec3 point = scene.actions.empty() ? scene.bodies.front().top : scene.actions.front().target;
   GloveLink glove(fmt::format("127.0.0.1:{}", fake.port()), scene.session.hand, point, [](std::string_view, bool) {});
-  for (const auto deadline = Clock::now() + std::chrono::seconds(5); !glove.closure(Finger::Index);)
-    if (Clock::now() > deadline || stopped(a))
-      throw Error("bench: the fake WEART middleware sent no tracking");
-    else
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  for (const auto deadline = Clock::now() + std::chrono::seconds(5); !glove.closure(Finger::Index);) {
+    if (stopped(a)) throw Stopped("bench: stopped");
+    if (Clock::now() > deadline) throw Error("bench: the fake WEART middleware sent no tracking");
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
 
   SimulationLoopSettings ls;
   ls.input = &glove.input();
@@ -617,7 +617,7 @@ std::pair<double, double> sagAndStrain(const World& world, BodyId body, float re
   return {restTop - topSum / std::max(topCount, 1), worst};
 }
 
-// Issue 6's targets, each measured here (2-core machine like CI).
+// Issues 6's and 32's targets, each measured here (2-core machine like CI).
 json targets(const BenchArgs& a, const json& table1Rows, std::string& text) {
   text += "Targets (issues 6 and 32)\n";
   json out;
