@@ -24,9 +24,11 @@ struct StudyArgs {
 
 int check(const StudyArgs& a) {
   const StudySpec s = loadStudy(a.study);
-  fmt::print("study {}: {} conditions, {} tasks x {} trials, {} questions in {} dimensions, {} comparisons\n", s.name,
-             s.conditions.size(), s.tasks.size(), s.trials, s.questions.size(), s.dimensions().size(),
-             s.comparisons.size());
+  fmt::print(
+      "study {}: {} conditions, {} tasks x {} trials, {} questions in {} dimensions, {} comparisons, {} free-text "
+      "items\n",
+      s.name, s.conditions.size(), s.tasks.size(), s.trials, s.questions.size(), s.dimensions().size(),
+      s.comparisons.size(), s.freeTexts.size());
   for (const StudyCondition& c : s.conditions)
     fmt::print("  condition {}: scene {}, force {}\n", c.name, c.scene,
                c.force == StudyForce::Multipliers ? "multipliers (A)" : "baseline (B)");
@@ -51,7 +53,8 @@ int analyse(const StudyArgs& a) {
                  s.conditions[t.b].name, t.pairs, t.result.wPlus, t.result.p, t.result.exact ? " (exact)" : "",
                  t.result.effectSize);
   fmt::print(
-      "wrote {}/: report.md tidy.csv descriptive.csv tests.csv order.csv comparisons.csv, figures as .svg and .png\n",
+      "wrote {}/: report.md tidy.csv descriptive.csv tests.csv order.csv comparisons.csv free_text.csv, figures as "
+      ".svg and .png\n",
       out);
   return 0;
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "vrdeform/core/text_tokens.h"
 #include "vrdeform/core/write_file.h"
@@ -80,6 +81,49 @@ std::optional<std::size_t> participantNumber(const std::string& name) {
   return k;
 }
 
+// free_text.json into p.freeText; each entry checked against the study's items and conditions.
+void readFreeText(const StudySpec& study, const fs::path& file, ParticipantAnswers& p) {
+  const nlohmann::json j = nlohmann::json::parse(io::readFileBytes(file), nullptr, false);
+  if (!j.is_array()) throw Error(fmt::format("{}: expected a JSON array of free-text answers", file.string()));
+  for (std::size_t n = 0; n < j.size(); ++n) {
+    const auto fail = [&](std::string_view what) {
+      throw Error(fmt::format("{}: answer {}: {}", file.string(), n + 1, what));
+    };
+    const nlohmann::json& e = j[n];
+    if (!e.is_object() || !e.contains("item") || !e["item"].is_string() || !e.contains("text") ||
+        !e["text"].is_string())
+      fail("expected an object with the strings \"item\" and \"text\"");
+    FreeTextAnswer a;
+    const std::string item = e["item"];
+    const std::optional<std::size_t> f =
+        indexOf(study.freeTexts, item, [](const StudyFreeText& x) -> std::string_view { return x.id; });
+    if (!f) fail(fmt::format("no free-text item '{}' in the study", io::printable(item)));
+    a.item = *f;
+    if (e.contains("condition")) {
+      if (!study.freeTexts[*f].perCondition) fail(fmt::format("{} is asked once, after all conditions", item));
+      const std::string name = e["condition"].is_string() ? e["condition"].get<std::string>() : "";
+      a.condition = indexOf(study.conditions, name, [](const StudyCondition& c) -> std::string_view { return c.name; });
+      if (!a.condition) fail(fmt::format("no condition '{}' in the study", io::printable(name)));
+    } else if (study.freeTexts[*f].perCondition) {
+      fail(fmt::format("{} is asked after each condition: the answer needs its \"condition\"", item));
+    }
+    if (std::any_of(p.freeText.begin(), p.freeText.end(),
+                    [&](const FreeTextAnswer& x) { return x.item == a.item && x.condition == a.condition; }))
+      fail(fmt::format("a second answer to {}", item));
+    a.text = e["text"];
+    p.freeText.push_back(std::move(a));
+  }
+}
+
+// A CSV field as RFC 4180 writes it: quoted (quotes doubled) when it holds a comma, a quote or a
+// line break.
+std::string csvField(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char ch : s) out += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return out + "\"";
+}
+
 ParticipantAnswers readParticipant(const StudySpec& study, const fs::path& dir, std::size_t number) {
   ParticipantAnswers p;
   p.number = number;
@@ -122,6 +166,7 @@ ParticipantAnswers readParticipant(const StudySpec& study, const fs::path& dir, 
       p.comparisons[*d] = int(rating);
     }
   }
+  if (const fs::path file = dir / "free_text.json"; fs::exists(file)) readFreeText(study, file, p);
   return p;
 }
 
@@ -266,6 +311,19 @@ void writeStudyAnalysis(const StudySpec& study, const std::vector<ParticipantAns
   }
   writeFile(outDir / "tidy.csv", tidy);
 
+  std::string freeText = "participant,position,condition,item,text\n";
+  for (const ParticipantAnswers& p : participants) {
+    const std::vector<std::size_t> order = study.orderOf(p.number);
+    for (const FreeTextAnswer& a : p.freeText) {
+      const std::size_t pos =
+          a.condition ? std::size_t(std::find(order.begin(), order.end(), *a.condition) - order.begin()) + 1 : 0;
+      freeText +=
+          fmt::format("{},{},{},{},{}\n", p.id, pos ? fmt::to_string(pos) : "",
+                      a.condition ? conditionName(*a.condition) : "", study.freeTexts[a.item].id, csvField(a.text));
+    }
+  }
+  writeFile(outDir / "free_text.csv", freeText);
+
   std::string descriptive = "measure,kind,condition,n,mean,sd,median,q1,q3\n";
   for (std::size_t m = 0; m < analysis.measures.size(); ++m)
     for (std::size_t c = 0; c < nc; ++c) {
@@ -402,8 +460,24 @@ void writeStudyAnalysis(const StudySpec& study, const std::vector<ParticipantAns
                         analysis.comparisonTests[d].result.p);
     }
   }
+  if (!study.freeTexts.empty()) {
+    md += "\n## Free text\n";
+    for (std::size_t f = 0; f < study.freeTexts.size(); ++f) {
+      md += fmt::format("\n### {}: {}\n\n", study.freeTexts[f].id, study.freeTexts[f].text);
+      for (const ParticipantAnswers& p : participants)
+        for (const FreeTextAnswer& a : p.freeText) {
+          if (a.item != f) continue;
+          std::string text = a.text;
+          std::replace_if(
+              text.begin(), text.end(), [](char ch) { return ch == '\n' || ch == '\r'; }, ' ');
+          md += fmt::format("- {}{}: {}\n", p.id, a.condition ? fmt::format(" ({})", conditionName(*a.condition)) : "",
+                            text);
+        }
+    }
+  }
   md +=
-      "\nFiles: tidy.csv (one row per answer), descriptive.csv, tests.csv, order.csv, comparisons.csv; the "
+      "\nFiles: tidy.csv (one row per answer), descriptive.csv, tests.csv, order.csv, comparisons.csv, "
+      "free_text.csv; the "
       "figures dimensions, items and comparisons, each as .svg and .png.\n";
   writeFile(outDir / "report.md", md);
 }

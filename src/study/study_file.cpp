@@ -51,7 +51,7 @@ std::string uniqueCsvName(const Table& t, std::string_view key, std::vector<std:
 
 StudySpec readStudy(const Table& root) {
   root.allowOnly({"format", "name", "description", "trials", "rest", "points", "comparison_range", "order", "condition",
-                  "task", "question", "comparison"});
+                  "task", "question", "comparison", "free_text"});
   if (const std::int64_t format = root.require("format").integer(); format != 1)
     root.fail("format", fmt::format("unknown format {} (this vrdeform reads format 1)", format));
   StudySpec s;
@@ -128,6 +128,15 @@ StudySpec readStudy(const Table& root) {
       c.b = index[1];
     }
     s.comparisons.push_back(std::move(c));
+  }
+  for (const Table& t : root.tables("free_text")) {
+    t.allowOnly({"id", "text", "after"});
+    StudyFreeText f;
+    f.id = uniqueCsvName(t, "id", ids);
+    f.text = t.require("text").name();
+    constexpr Option<bool> kAfter[] = {{"condition", true}, {"study", false}};
+    t.readChoice("after", f.perCondition, kAfter);
+    s.freeTexts.push_back(std::move(f));
   }
   if (s.questions.empty() && s.comparisons.empty())
     root.fail("question", "needs at least one [[question]] or [[comparison]]");

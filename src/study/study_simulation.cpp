@@ -128,7 +128,7 @@ StudyRunResult runSimulatedParticipant(const StudySpec& study, const StudyRunSet
   const fs::path me = settings.dataDir / fmt::format("P{}", settings.participant);
   prepareOutputFolder(me / "trials");
   StudyRunResult result;
-  std::vector<double> score(study.conditions.size(), 0.0);
+  std::vector<double> score(study.conditions.size(), 0.0), roughness(score), spearman(score);
   for (std::size_t pos = 0; pos < order.size(); ++pos) {
     const StudyCondition& c = study.conditions[order[pos]];
     double sum = 0.0;
@@ -151,9 +151,13 @@ StudyRunResult runSimulatedParticipant(const StudySpec& study, const StudyRunSet
                             j["felt_roughness"].get<double>(), j["felt_spearman"].get<double>()));
         }
         sum += feltScore({j["felt_roughness"].get<double>(), j["felt_spearman"].get<double>(), 0.0}, study.points);
+        roughness[order[pos]] += j["felt_roughness"].get<double>();
+        spearman[order[pos]] += j["felt_spearman"].get<double>();
         ++count;
       }
     score[order[pos]] = sum / count;
+    roughness[order[pos]] /= count;
+    spearman[order[pos]] /= count;
   }
 
   // The answers: items of the "visual" dimension alike in every condition (the same picture), the
@@ -174,6 +178,21 @@ StudyRunResult runSimulatedParticipant(const StudySpec& study, const StudyRunSet
                                                        study.conditions.size(), study.questions.size() + d),
                                           -study.comparisonRange, study.comparisonRange));
   }
+  // Free text: what was felt in each condition, and which felt best.
+  nlohmann::json freeText = nlohmann::json::array();
+  const std::size_t best = std::size_t(std::max_element(score.begin(), score.end()) - score.begin());
+  for (const StudyFreeText& f : study.freeTexts) {
+    if (!f.perCondition) {
+      freeText.push_back({{"item", f.id}, {"text", fmt::format("{} felt best.", study.conditions[best].name)}});
+      continue;
+    }
+    for (std::size_t c : order)
+      freeText.push_back({{"item", f.id},
+                          {"condition", study.conditions[c].name},
+                          {"text", fmt::format("The force {} as I pressed (roughness {:.2f}, loading Spearman {:.3f}).",
+                                               roughness[c] <= 1.1 && spearman[c] >= 0.9 ? "grew smoothly" : "jumped",
+                                               roughness[c], spearman[c])}});
+  }
   nlohmann::json who{{"participant", fmt::format("P{}", settings.participant)},
                      {"number", settings.participant},
                      {"simulated", true},
@@ -182,6 +201,7 @@ StudyRunResult runSimulatedParticipant(const StudySpec& study, const StudyRunSet
   for (std::size_t c : order) who["order"].push_back(study.conditions[c].name);
   writeFile(me / "answers.csv", answers);
   writeFile(me / "comparisons.csv", comparisons);
+  writeFile(me / "free_text.json", freeText.dump(2) + "\n");
   writeFile(me / "participant.json", who.dump(2) + "\n");
   return result;
 }

@@ -169,6 +169,61 @@ std::string errorOf(const fs::path& dir, const std::string& answers) {
   return "no error";
 }
 
+// Free text goes into free_text.csv as RFC 4180 quotes it (commas, quotes and line breaks kept)
+// and into the report, per item; answers that do not fit the study are named with their file.
+TEST(StudyAnalysis, FreeTextIsKeptAsWritten) {
+  const StudySpec study = parseStudy(std::string(kStudy) +
+                                         "[[free_text]]\nid = \"F1\"\ntext = \"What did you feel?\"\n"
+                                         "[[free_text]]\nid = \"F2\"\ntext = \"Anything else?\"\nafter = \"study\"\n",
+                                     "two.toml", ".");
+  Folder data;
+  writeData(data.path);
+  writeFile(data.path / "P2" / "free_text.json",
+            R"([{"item": "F1", "condition": "B", "text": "Firm, then \"stepped\"\nat the end"},
+                {"item": "F2", "text": "No"}])");
+  const std::vector<ParticipantAnswers> people = readStudyAnswers(study, data.path);
+  ASSERT_EQ(people[1].freeText.size(), 2u);
+  EXPECT_EQ(people[1].freeText[0].condition, 1u);
+  EXPECT_EQ(people[1].freeText[0].text, "Firm, then \"stepped\"\nat the end");
+  const fs::path out = data.path / "analysis";
+  writeStudyAnalysis(study, people, analyseStudy(study, people), out);
+  std::ifstream csv(out / "free_text.csv");
+  const std::string text{std::istreambuf_iterator<char>(csv), {}};
+  // P2 met B first (the Latin square's second row).
+  EXPECT_EQ(text,
+            "participant,position,condition,item,text\nP2,1,B,F1,\"Firm, then \"\"stepped\"\"\nat the end\"\n"
+            "P2,,,F2,No\n");
+  std::ifstream md(out / "report.md");
+  const std::string report{std::istreambuf_iterator<char>(md), {}};
+  EXPECT_NE(report.find("### F1: What did you feel?\n\n- P2 (B): Firm, then \"stepped\" at the end\n"),
+            std::string::npos)
+      << report;
+  EXPECT_NE(report.find("### F2: Anything else?\n\n- P2: No\n"), std::string::npos);
+
+  const auto bad = [&](const std::string& json) {
+    writeFile(data.path / "P2" / "free_text.json", json);
+    try {
+      readStudyAnswers(study, data.path);
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      return what.substr(what.find("free_text.json"));
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(bad("{"), "free_text.json: expected a JSON array of free-text answers");
+  EXPECT_EQ(bad(R"([{"item": "F9", "text": "x"}])"), "free_text.json: answer 1: no free-text item 'F9' in the study");
+  EXPECT_EQ(bad(R"([{"item": "F1", "text": "x"}])"),
+            "free_text.json: answer 1: F1 is asked after each condition: the answer needs its \"condition\"");
+  EXPECT_EQ(bad(R"([{"item": "F2", "condition": "A", "text": "x"}])"),
+            "free_text.json: answer 1: F2 is asked once, after all conditions");
+  EXPECT_EQ(bad(R"([{"item": "F1", "condition": "C", "text": "x"}])"),
+            "free_text.json: answer 1: no condition 'C' in the study");
+  EXPECT_EQ(bad(R"([{"item": "F2", "text": "x"}, {"item": "F2", "text": "y"}])"),
+            "free_text.json: answer 2: a second answer to F2");
+  EXPECT_EQ(bad(R"([{"item": "F2", "text": 3}])"),
+            "free_text.json: answer 1: expected an object with the strings \"item\" and \"text\"");
+}
+
 TEST(StudyAnalysis, BadAnswersAreNamedWithFileAndLine) {
   Folder data;
   fs::create_directories(data.path / "P1");

@@ -75,6 +75,23 @@ TEST(StudyFile, OrdersFollowTheBalancedLatinSquare) {
   EXPECT_THROW(s.orderOf(0), Error);
 }
 
+TEST(StudyFile, FreeTextItemsAreAskedAfterEachConditionOrOnce) {
+  const StudySpec s = parseStudy(std::string(kSmall) +
+                                     "[[free_text]]\nid = \"F1\"\ntext = \"What did you feel?\"\n"
+                                     "[[free_text]]\nid = \"F2\"\ntext = \"Anything else?\"\nafter = \"study\"\n",
+                                 "s.toml", ".");
+  ASSERT_EQ(s.freeTexts.size(), 2u);
+  EXPECT_EQ(s.freeTexts[0].id, "F1");
+  EXPECT_EQ(s.freeTexts[0].text, "What did you feel?");
+  EXPECT_TRUE(s.freeTexts[0].perCondition);
+  EXPECT_FALSE(s.freeTexts[1].perCondition);
+  EXPECT_EQ(errorOf(std::string(kSmall) + "[[free_text]]\nid = \"D1\"\ntext = \"x\"\n"),
+            "s.toml:24: free_text[1].id: 'D1' is the id of an earlier entry too");
+  EXPECT_EQ(errorOf(std::string(kSmall) + "[[free_text]]\nid = \"F1\"\ntext = \"x\"\nafter = \"trial\"\n"),
+            "s.toml:26: free_text[1].after: unknown value 'trial' (expected one of: condition, study)");
+  EXPECT_EQ(errorOf(std::string(kSmall) + "[[free_text]]\nid = \"F1\"\n"), "s.toml:23: free_text[1].text: missing");
+}
+
 TEST(StudyFile, MistakesAreNamedWithLineAndKey) {
   const std::string small = kSmall;
   const auto with = [&](const std::string& from, const std::string& to) {

@@ -48,6 +48,13 @@ text = "The force felt smooth."
 [[comparison]]
 id = "D1"
 text = "Which force felt more natural?"
+[[free_text]]
+id = "F1"
+text = "What did you feel?"
+[[free_text]]
+id = "F2"
+text = "Which felt best?"
+after = "study"
 )";
 
 struct Folder {
@@ -96,6 +103,15 @@ TEST(StudySimulation, FourParticipantsRunTheStudyInTheirOrders) {
     for (const auto& condition : p.answers)
       for (const auto& answer : condition) EXPECT_TRUE(answer.has_value()) << p.id;
     EXPECT_TRUE(p.comparisons[0].has_value()) << p.id;
+    // F1 after each condition, F2 once: what was felt, in words (B's baseline steps up at first contact).
+    ASSERT_EQ(p.freeText.size(), 3u) << p.id;
+    for (const FreeTextAnswer& f : p.freeText) {
+      EXPECT_EQ(f.condition.has_value(), f.item == 0) << p.id;
+      if (f.condition) {
+        EXPECT_NE(f.text.find(*f.condition == 0 ? "grew smoothly" : "jumped"), std::string::npos) << f.text;
+      }
+    }
+    EXPECT_EQ(p.freeText.back().text, "A felt best.") << p.id;
   }
   // What was felt decides the felt items: A's force rises with the indentation, B's baseline is
   // flat while loading (a step), so every participant rates the haptic dimension higher under A.

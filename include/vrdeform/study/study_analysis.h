@@ -15,6 +15,13 @@
 
 namespace vrd {
 
+/// An answer to a free-text item (free_text.json).
+struct FreeTextAnswer {
+  std::size_t item = 0;                  ///< index into study.freeTexts
+  std::optional<std::size_t> condition;  ///< for an item asked after each condition
+  std::string text;
+};
+
 /// One participant's answers: folder P<k> of the data folder (docs/study.md's layout).
 struct ParticipantAnswers {
   std::size_t number = 0;  ///< k, from the folder's name; their order of the conditions follows from it
@@ -23,12 +30,14 @@ struct ParticipantAnswers {
   std::vector<std::vector<std::optional<int>>> answers;
   /// comparisons[comparison]: the rating in -range..range, or nullopt where none was given.
   std::vector<std::optional<int>> comparisons;
+  std::vector<FreeTextAnswer> freeText;  ///< in the file's order
 };
 
-/// Reads every participant folder (P1, P02, ...) of `dataDir`: answers.csv (`condition,item,answer`)
-/// and comparisons.csv (`item,rating`), either of which may be missing. Throws vrd::Error naming the
-/// file and line of an unknown condition or item, an answer outside 1..points, a repeated row or a
-/// malformed line, and when no participant folder is there.
+/// Reads every participant folder (P1, P02, ...) of `dataDir`: answers.csv (`condition,item,answer`),
+/// comparisons.csv (`item,rating`) and free_text.json (an array of {"item", "condition" for the
+/// items asked after each condition, "text"}), any of which may be missing. Throws vrd::Error naming
+/// the file and line (or entry) of an unknown condition or item, an answer outside 1..points, a
+/// repeated answer or a malformed line, and when no participant folder is there.
 std::vector<ParticipantAnswers> readStudyAnswers(const StudySpec& study, const std::filesystem::path& dataDir);
 
 /// Mean, sample standard deviation (n - 1), median and quartiles (linear interpolation between
@@ -71,7 +80,8 @@ struct StudyAnalysis {
 StudyAnalysis analyseStudy(const StudySpec& study, const std::vector<ParticipantAnswers>& participants);
 
 /// Writes tidy.csv (participant, position, condition, item, dimension, answer: one row per answer),
-/// descriptive.csv, tests.csv, order.csv, comparisons.csv, the figures dimensions (box plots per
+/// descriptive.csv, tests.csv, order.csv, comparisons.csv, free_text.csv (participant, position,
+/// condition, item, text; RFC 4180 quoting), the figures dimensions (box plots per
 /// dimension and condition), items (each item's mean difference for every pair of conditions) and
 /// comparisons (the direct comparisons' ratings), each as .svg and .png, and report.md into
 /// `outDir`, each file complete or not at all. Throws vrd::Error.

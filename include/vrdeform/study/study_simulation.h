@@ -36,8 +36,8 @@ struct StudyRunResult {
 /// answers. Each trial's files go into P<k>/trials/<position>-<task>-<trial>/ (the run's per-step
 /// forces.csv, summary.json and trial.json with what was felt), written into a scratch folder and
 /// renamed into place when complete, so a run stopped or killed part-way loses no finished trial
-/// and a second run of the same participant picks up where it ended. participant.json, answers.csv
-/// and comparisons.csv (docs/study.md) are written last, each complete or not at all. Throws
+/// and a second run of the same participant picks up where it ended. participant.json, answers.csv,
+/// comparisons.csv and free_text.json (docs/study.md) are written last, each complete or not at all. Throws
 /// vrd::Error for a scene that cannot be built or run, vrd::Stopped when `stop` says so.
 StudyRunResult runSimulatedParticipant(const StudySpec& study, const StudyRunSettings& settings);
 

@@ -42,6 +42,15 @@ struct StudyComparison {
   std::size_t a = 0, b = 1;  ///< the conditions compared (indices)
 };
 
+/// A free-text item: a question answered in the participant's own words, after each condition or
+/// once after all of them. Kept as written (free_text.json, the analysis's free_text.csv and
+/// report), not scored.
+struct StudyFreeText {
+  std::string id;  ///< unique among questions, comparisons and free-text items, e.g. "F1"
+  std::string text;
+  bool perCondition = true;  ///< asked after each condition; false: once, after all conditions
+};
+
 enum class Counterbalancing {
   LatinSquare,  ///< participant k's order from Williams' balanced Latin square (metrics/latin_square.h)
   Fixed,        ///< every participant in the file's order
@@ -59,6 +68,7 @@ struct StudySpec {
   int comparisonRange = 3;  ///< direct comparisons are rated on -range..range
   std::vector<StudyQuestion> questions;
   std::vector<StudyComparison> comparisons;
+  std::vector<StudyFreeText> freeTexts;
   Counterbalancing order = Counterbalancing::LatinSquare;
 
   /// Participant k's (from 1) order of the conditions, as indices into `conditions`.
