@@ -49,9 +49,11 @@ std::string uniqueCsvName(const Table& t, std::string_view key, std::vector<std:
   return name;
 }
 
+constexpr Option<StudyForce> kForces[] = {{"multipliers", StudyForce::Multipliers}, {"baseline", StudyForce::Baseline}};
+
 StudySpec readStudy(const Table& root) {
   root.allowOnly({"format", "name", "description", "trials", "rest", "points", "comparison_range", "order", "condition",
-                  "task", "question", "comparison", "free_text"});
+                  "task", "practice", "question", "comparison", "free_text"});
   if (const std::int64_t format = root.require("format").integer(); format != 1)
     root.fail("format", fmt::format("unknown format {} (this vrdeform reads format 1)", format));
   StudySpec s;
@@ -71,8 +73,6 @@ StudySpec readStudy(const Table& root) {
     StudyCondition c;
     c.name = uniqueCsvName(t, "name", names);
     c.scene = readSceneName(t.require("scene"));
-    constexpr Option<StudyForce> kForces[] = {{"multipliers", StudyForce::Multipliers},
-                                              {"baseline", StudyForce::Baseline}};
     t.readChoice("force", c.force, kForces);
     s.conditions.push_back(std::move(c));
   }
@@ -90,6 +90,18 @@ StudySpec readStudy(const Table& root) {
     s.tasks.push_back(std::move(task));
   }
   if (s.tasks.empty()) root.fail("task", "needs at least one [[task]]");
+
+  if (root.has("practice")) {
+    const Table t = root.table("practice");
+    t.allowOnly({"scene", "force", "seconds", "instructions"});
+    StudyPractice p{s.conditions.front(), {}};
+    p.condition.name = p.task.name = "practice";
+    if (const std::optional<Field> f = t.get("scene")) p.condition.scene = readSceneName(*f);
+    t.readChoice("force", p.condition.force, kForces);
+    t.readNumber("seconds", p.task.seconds, kNonNegative);
+    t.readString("instructions", p.task.instructions);
+    s.practice = std::move(p);
+  }
 
   std::vector<std::string> ids;
   for (const Table& t : root.tables("question")) {

@@ -128,6 +128,17 @@ StudyRunResult runSimulatedParticipant(const StudySpec& study, const StudyRunSet
   const fs::path me = settings.dataDir / fmt::format("P{}", settings.participant);
   prepareOutputFolder(me / "trials");
   StudyRunResult result;
+  if (study.practice) {
+    const fs::path dir = me / "practice";
+    if (fs::is_regular_file(dir / "trial.json")) {
+      readTrial(dir / "trial.json");
+      ++result.trialsKept;
+    } else {
+      runTrial(study.practice->condition, study.practice->task, 1, dir, settings);
+      ++result.trialsRun;
+      if (settings.log) settings.log(fmt::format("P{}: practice", settings.participant));
+    }
+  }
   std::vector<double> score(study.conditions.size(), 0.0), roughness(score), spearman(score);
   for (std::size_t pos = 0; pos < order.size(); ++pos) {
     const StudyCondition& c = study.conditions[order[pos]];

@@ -92,6 +92,25 @@ TEST(StudyFile, FreeTextItemsAreAskedAfterEachConditionOrOnce) {
   EXPECT_EQ(errorOf(std::string(kSmall) + "[[free_text]]\nid = \"F1\"\n"), "s.toml:23: free_text[1].text: missing");
 }
 
+// A practice trial on the first condition's scene unless it names its own.
+TEST(StudyFile, APracticeTrialComesFirst) {
+  EXPECT_FALSE(parseStudy(kSmall, "s.toml", ".").practice);
+  const StudySpec s =
+      parseStudy(std::string(kSmall) + "[practice]\nseconds = 30\ninstructions = \"Try it.\"\n", "s.toml", ".");
+  ASSERT_TRUE(s.practice);
+  EXPECT_EQ(s.practice->condition.scene, "liver");
+  EXPECT_EQ(s.practice->condition.force, StudyForce::Multipliers);
+  EXPECT_EQ(s.practice->task.seconds, 30.0);
+  EXPECT_EQ(s.practice->task.instructions, "Try it.");
+  EXPECT_EQ(parseStudy(std::string(kSmall) + "[practice]\nscene = \"jelly\"\nforce = \"baseline\"\n", "s.toml", ".")
+                .practice->condition.scene,
+            "jelly");
+  EXPECT_EQ(errorOf(std::string(kSmall) + "[practice]\nscene = \"jely\"\n").substr(0, 40),
+            "s.toml:24: practice.scene: no built-in s");
+  EXPECT_EQ(errorOf(std::string(kSmall) + "[practice]\ntrials = 2\n"),
+            "s.toml:24: practice.trials: unknown key (expected one of: scene, force, seconds, instructions)");
+}
+
 TEST(StudyFile, MistakesAreNamedWithLineAndKey) {
   const std::string small = kSmall;
   const auto with = [&](const std::string& from, const std::string& to) {

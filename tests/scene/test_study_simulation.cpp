@@ -122,6 +122,28 @@ TEST(StudySimulation, FourParticipantsRunTheStudyInTheirOrders) {
   EXPECT_LT(a.comparisons[0].mean, 0.0) << "D1 favours A";
 }
 
+// The practice trial runs first, into its own folder, is kept on a second run and is not analysed.
+TEST(StudySimulation, ThePracticeTrialComesFirstAndIsKept) {
+  const StudySpec study =
+      parseStudy(std::string(kStudy) + "[practice]\nscene = \"jelly\"\nseconds = 0.5\n", "practice.toml", ".");
+  Folder data("practice");
+  StudyRunSettings s;
+  s.dataDir = data.path;
+  std::vector<std::string> log;
+  s.log = [&](const std::string& line) { log.push_back(line); };
+  EXPECT_EQ(runSimulatedParticipant(study, s).trialsRun, 3u);
+  ASSERT_FALSE(log.empty());
+  EXPECT_EQ(log.front(), "P1: practice");
+  const nlohmann::json trial = nlohmann::json::parse(read(data.path / "P1" / "practice" / "trial.json"));
+  EXPECT_EQ(trial["condition"], "practice");
+  EXPECT_EQ(trial["scene"], "jelly");
+  EXPECT_EQ(trial["steps"], 30);
+  const StudyRunResult again = runSimulatedParticipant(study, s);
+  EXPECT_EQ(again.trialsRun, 0u);
+  EXPECT_EQ(again.trialsKept, 3u);
+  EXPECT_EQ(readStudyAnswers(study, data.path).size(), 1u);
+}
+
 TEST(StudySimulation, AStoppedRunResumesKeepingEveryFinishedTrial) {
   const StudySpec study = parseStudy(kStudy, "poke.toml", ".");
   Folder data("resumed"), whole("whole");

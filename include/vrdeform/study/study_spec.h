@@ -5,6 +5,7 @@
 // counterbalancing of the conditions' order. Plain data, checked by the parser (study_file.h).
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,13 @@ struct StudyTask {
   std::string name;          ///< unique, e.g. "poke"
   std::string instructions;  ///< shown to the participant before the task's first trial
   double seconds = 0.0;      ///< how long a trial lasts; 0: the scene's own length
+};
+
+/// A practice trial before the first condition, so that the participant learns the set-up; its data
+/// is kept (P<k>/practice/) but not analysed.
+struct StudyPractice {
+  StudyCondition condition;  ///< the scene and force practised on (named "practice")
+  StudyTask task;            ///< its instructions and length (named "practice")
 };
 
 /// A Likert item: a statement rated on 1..points between two anchors.
@@ -62,6 +70,7 @@ struct StudySpec {
   std::string source;  ///< the file it came from
   std::vector<StudyCondition> conditions;
   std::vector<StudyTask> tasks;
+  std::optional<StudyPractice> practice;
   int trials = 3;           ///< per task and condition
   double restSeconds = 0;   ///< between conditions
   int points = 7;           ///< of every Likert item
