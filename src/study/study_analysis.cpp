@@ -81,6 +81,10 @@ std::optional<std::size_t> participantNumber(const std::string& name) {
   return k;
 }
 
+std::optional<std::size_t> conditionIndex(const StudySpec& study, std::string_view name) {
+  return indexOf(study.conditions, name, [](const StudyCondition& c) -> std::string_view { return c.name; });
+}
+
 // free_text.json into p.freeText; each entry checked against the study's items and conditions.
 void readFreeText(const StudySpec& study, const fs::path& file, ParticipantAnswers& p) {
   const nlohmann::json j = nlohmann::json::parse(io::readFileBytes(file), nullptr, false);
@@ -102,7 +106,7 @@ void readFreeText(const StudySpec& study, const fs::path& file, ParticipantAnswe
     if (e.contains("condition")) {
       if (!study.freeTexts[*f].perCondition) fail(fmt::format("{} is asked once, after all conditions", item));
       const std::string name = e["condition"].is_string() ? e["condition"].get<std::string>() : "";
-      a.condition = indexOf(study.conditions, name, [](const StudyCondition& c) -> std::string_view { return c.name; });
+      a.condition = conditionIndex(study, name);
       if (!a.condition) fail(fmt::format("no condition '{}' in the study", io::printable(name)));
     } else if (study.freeTexts[*f].perCondition) {
       fail(fmt::format("{} is asked after each condition: the answer needs its \"condition\"", item));
@@ -130,14 +134,13 @@ ParticipantAnswers readParticipant(const StudySpec& study, const fs::path& dir, 
   p.id = dir.filename().string();
   p.answers.assign(study.conditions.size(), std::vector<std::optional<int>>(study.questions.size()));
   p.comparisons.assign(study.comparisons.size(), std::nullopt);
-  const auto conditionName = [](const StudyCondition& c) -> std::string_view { return c.name; };
   if (const fs::path file = dir / "answers.csv"; fs::exists(file)) {
     const std::string text = io::readFileBytes(file);
     for (const CsvRow& row : readCsv(text, file, {"condition", "item", "answer"})) {
       const auto fail = [&](std::string_view what) {
         throw Error(fmt::format("{}:{}: {}", file.string(), row.line, what));
       };
-      const std::optional<std::size_t> c = indexOf(study.conditions, row.fields[0], conditionName);
+      const std::optional<std::size_t> c = conditionIndex(study, row.fields[0]);
       if (!c) fail(fmt::format("no condition '{}' in the study", io::printable(row.fields[0])));
       const std::optional<std::size_t> q =
           indexOf(study.questions, row.fields[1], [](const StudyQuestion& x) -> std::string_view { return x.id; });
