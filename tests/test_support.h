@@ -7,7 +7,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -16,6 +20,14 @@
 #include "vrdeform/error.h"
 
 namespace vrd::testing {
+
+constexpr float kG = 9.81f;  ///< m/s^2, standard gravity as the scenes use it
+
+/// Spacing of the float grid at x (one ulp).
+inline double ulp(float x) {
+  const float a = std::fabs(x);
+  return double(std::nextafter(a, std::numeric_limits<float>::infinity())) - double(a);
+}
 
 /// Records a measured value in the test report (--gtest_output=xml), so that a run documents the
 /// figures behind its assertions.
@@ -59,6 +71,32 @@ std::string mutate(std::string text, Rng& rng, std::string_view alphabet) {
       break;
   }
   return text;
+}
+
+/// The meshes shipped beside the repository (../shared/data/meshes).
+inline const std::filesystem::path kMeshes = std::filesystem::path(VRDEFORM_SHARED_DIR) / "data" / "meshes";
+
+/// A file's bytes ("" when it cannot be read).
+inline std::string readBytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// Writes a new file (not a truncated one: ext4 flushes a file rewritten after truncation when it
+/// is closed, which costs milliseconds each time).
+inline void writeBytes(const std::filesystem::path& path, std::string_view bytes) {
+  std::filesystem::remove(path);
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  ASSERT_TRUE(out.good()) << path;
+}
+
+/// Participant k's folder (P1, P2, ...) in a study's data folder. (Appended rather than "P" + ...:
+/// GCC 12 reports a false -Wrestrict on that once it is inlined into some callers.)
+inline std::filesystem::path participantFolder(const std::filesystem::path& data, int k) {
+  std::string name = "P";
+  name += std::to_string(k);
+  return data / name;
 }
 
 /// A fresh folder under the system's temporary folder, removed with its contents afterwards.

@@ -15,14 +15,14 @@
 namespace vrd {
 namespace {
 
-constexpr std::string_view kTag = "vrdeform-session";
-constexpr std::int64_t kVersion = 1;
+constexpr std::string_view kSessionTag = "vrdeform-session";
+constexpr std::int64_t kSessionVersion = 1;
 constexpr std::string_view kSetting = "setting";
 constexpr std::string_view kEnd = "end";
 // Fields of a step line before its outputs: index, direct, wrist 3x4, closures, fingertips, count.
 constexpr std::size_t kWrist = 2, kClosure = kWrist + 12, kTips = kClosure + kFingerCount,
                       kCount = kTips + 3 * kFingerCount, kFixedFields = kCount + 1;
-constexpr const char* kLayout =
+constexpr const char* kStepLayout =
     "step direct  wrist 3x4 row by row (m)  closures thumb..little  fingertips 5 x (x y z) (m)  output-count outputs";
 
 bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
@@ -45,7 +45,7 @@ void appendFloat(std::string& out, float v) {
   out.append(buffer, result.ptr);
 }
 
-bool parseFloat(std::string_view token, float& value) {
+bool parseHexFloat(std::string_view token, float& value) {
   const bool negative = !token.empty() && token.front() == '-';
   if (negative) token.remove_prefix(1);
   float magnitude = 0;
@@ -86,8 +86,8 @@ std::string settingProblem(std::string_view key, std::string_view value) {
 // One step line; `index` is the step it must be.
 RecordedStep parseStep(const std::vector<std::string_view>& t, std::size_t index, const io::TextTokens& lines) {
   if (t.size() < kFixedFields)
-    lines.fail(
-        fmt::format("a step line has at least {} fields ({}), found {}: truncated?", kFixedFields, kLayout, t.size()));
+    lines.fail(fmt::format("a step line has at least {} fields ({}), found {}: truncated?", kFixedFields, kStepLayout,
+                           t.size()));
   std::int64_t number = -1;
   if (!io::parseInteger(t[0], number) || number < 0)
     lines.fail(fmt::format("expected a step number, found '{}'", io::printable(t[0])));
@@ -100,7 +100,7 @@ RecordedStep parseStep(const std::vector<std::string_view>& t, std::size_t index
   step.frame.direct = t[1] == "1";
   auto number32 = [&](std::size_t i) {
     float v = 0;
-    if (!parseFloat(t[i], v))
+    if (!parseHexFloat(t[i], v))
       lines.fail(fmt::format("step {}, field {}: expected a hexadecimal float such as 0x1.8p+3, found '{}'", index,
                              i + 1, io::printable(t[i])));
     return v;
@@ -131,7 +131,7 @@ const std::string* SessionRecording::setting(std::string_view key) const {
 namespace {
 
 void appendHeader(std::string& out, const std::vector<std::pair<std::string, std::string>>& settings) {
-  fmt::format_to(std::back_inserter(out), "{} {}\n", kTag, kVersion);
+  fmt::format_to(std::back_inserter(out), "{} {}\n", kSessionTag, kSessionVersion);
   for (std::size_t i = 0; i < settings.size(); ++i) {
     const auto& [key, value] = settings[i];
     const std::string what = settingProblem(key, value);
@@ -140,7 +140,7 @@ void appendHeader(std::string& out, const std::vector<std::pair<std::string, std
       if (settings[j].first == key) throw Error(fmt::format("session recording: setting '{}' appears twice", key));
     fmt::format_to(std::back_inserter(out), "{} {}{}{}\n", kSetting, key, value.empty() ? "" : " ", value);
   }
-  fmt::format_to(std::back_inserter(out), "# {}\n", kLayout);
+  fmt::format_to(std::back_inserter(out), "# {}\n", kStepLayout);
 }
 
 void appendStep(std::string& out, std::uint64_t k, const RecordedStep& step) {
@@ -217,11 +217,12 @@ SessionRecording SessionRecording::parse(std::string_view text, std::string_view
     if (tokens.empty()) continue;  // cannot happen after atEnd(), but costs nothing to be sure
     if (!tagged) {
       std::int64_t version = 0;
-      if (tokens.size() != 2 || tokens[0] != kTag || !io::parseInteger(tokens[1], version))
-        lines.fail(fmt::format("not a session recording: expected '{} {}' first, found '{}'", kTag, kVersion,
-                               io::printable(line)));
-      if (version != kVersion)
-        lines.fail(fmt::format("unsupported {} version {} (this program reads version {})", kTag, version, kVersion));
+      if (tokens.size() != 2 || tokens[0] != kSessionTag || !io::parseInteger(tokens[1], version))
+        lines.fail(fmt::format("not a session recording: expected '{} {}' first, found '{}'", kSessionTag,
+                               kSessionVersion, io::printable(line)));
+      if (version != kSessionVersion)
+        lines.fail(fmt::format("unsupported {} version {} (this program reads version {})", kSessionTag, version,
+                               kSessionVersion));
       tagged = true;
     } else if (ended) {
       lines.fail(fmt::format("'{}' found after the '{}' line", io::printable(line), kEnd));

@@ -2,6 +2,7 @@
 // The readers and writers behind readTetMesh/writeTetMesh, one file per format. A reader gets the
 // file's bytes and its name for messages; indices it returns are checked to be in range.
 
+#include <cstdint>
 #include <filesystem>
 #include <ostream>
 #include <span>
@@ -29,6 +30,10 @@ void writeMedit(std::ostream& out, const TetMesh& mesh);
 
 TetMesh readGmsh(std::string_view text, const std::string& name, std::vector<Triangle>* faces);
 void writeGmsh(std::ostream& out, const TetMesh& mesh, GmshVersion version);
+
+/// VTK's cell type ids (both VTK formats): the cells the readers keep, and the higher-order tets
+/// they refuse by name.
+constexpr std::int64_t kVtkTriangle = 5, kVtkTet = 10, kVtkQuadraticTet = 24, kVtkLagrangeTet = 71;
 
 TetMesh readVtkLegacy(std::string_view text, const std::string& name, std::vector<Triangle>* faces);
 void writeVtkLegacy(std::ostream& out, const TetMesh& mesh);

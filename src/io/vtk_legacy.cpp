@@ -20,8 +20,6 @@
 namespace vrd::io {
 namespace {
 
-constexpr std::int64_t kVtkTriangle = 5, kVtkTet = 10, kVtkQuadraticTet = 24, kVtkLagrangeTet = 71;
-
 std::string upper(std::string_view s) {
   std::string u(s);
   for (char& c : u) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));

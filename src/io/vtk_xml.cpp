@@ -25,7 +25,6 @@
 namespace vrd::io {
 namespace {
 
-constexpr std::int64_t kVtkTriangle = 5, kVtkTet = 10, kVtkQuadraticTet = 24, kVtkLagrangeTet = 71;
 // Deflate cannot compress by more than about 1032:1; a block claiming more is corrupt, and checking
 // this bounds what a small file can make us allocate.
 constexpr std::uint64_t kMaxInflateRatio = 1032;
@@ -62,9 +61,9 @@ class ArraySource {
   std::string decoded_;
 };
 
-class Reader {
+class VtuReader {
  public:
-  Reader(std::string_view text, const std::string& name) : text_(text), name_(name) {}
+  VtuReader(std::string_view text, const std::string& name) : text_(text), name_(name) {}
 
   TetMesh read(std::vector<Triangle>* faces) {
     parse();
@@ -395,7 +394,7 @@ void encodeBinary(const std::string& bytes, bool compress, std::string& header, 
 }  // namespace
 
 TetMesh readVtu(std::string_view text, const std::string& name, std::vector<Triangle>* faces) {
-  return Reader(text, name).read(faces);
+  return VtuReader(text, name).read(faces);
 }
 
 template <std::size_t N>

@@ -15,7 +15,7 @@
 namespace vrd {
 namespace {
 
-constexpr float kG = 9.81f;
+using testing::kG;
 
 std::shared_ptr<BodyModel> singleParticle(const Vec3& at, float mass = 1.0f) {
   auto m = std::make_shared<BodyModel>();

@@ -18,7 +18,7 @@ namespace {
 
 using testing::errorOf;
 
-constexpr float kG = 9.81f;
+using testing::kG;
 
 // --- The projection ----------------------------------------------------------------------------
 
@@ -66,7 +66,7 @@ TEST(FingertipTriangles, KinematicAndDegenerateTrianglesDoNothing) {
 // --- A block on the ground ---------------------------------------------------------------------
 
 // The V12 block (block_on_ground.h) with what these tests read off its surface.
-struct BlockOnGround : testing::BlockOnGround {
+struct SurfaceBlock : testing::BlockOnGround {
   using testing::BlockOnGround::BlockOnGround;
   // Centroid, now, of the first surface triangle in the top face (the block sags under its weight).
   Vec3 topTriangleCentroid() const {
@@ -107,7 +107,7 @@ constexpr int kCoarseCells = 2;
 constexpr float kSmallRadius = 0.01f;  // the nearest vertex is 4.7 cm from a top triangle's centroid
 
 TEST(FingertipTriangles, ParticlesModePassesBetweenTheVerticesOfACoarseFace) {
-  BlockOnGround block(kCoarseSide, kCoarseCells), reference(kCoarseSide, kCoarseCells);
+  SurfaceBlock block(kCoarseSide, kCoarseCells), reference(kCoarseSide, kCoarseCells);
   block.settle();
   reference.settle();
   const Vec3 centroid = block.topTriangleCentroid();
@@ -129,7 +129,7 @@ TEST(FingertipTriangles, ParticlesModePassesBetweenTheVerticesOfACoarseFace) {
 
 TEST(FingertipTriangles, TrianglesModePushesTheFaceBetweenVertices) {
   const int substeps = 4;
-  BlockOnGround block(kCoarseSide, kCoarseCells, substeps);
+  SurfaceBlock block(kCoarseSide, kCoarseCells, substeps);
   block.settle();
   const Vec3 centroid = block.topTriangleCentroid();
   const Vec3 above = centroid + Vec3(0.0f, 2.0f * kSmallRadius, 0.0f);
@@ -177,7 +177,7 @@ TEST(FingertipTriangles, TrianglesModePushesTheFaceBetweenVertices) {
 }
 
 TEST(FingertipTriangles, DisabledFingertipMakesNoContacts) {
-  BlockOnGround block(kCoarseSide, kCoarseCells);
+  SurfaceBlock block(kCoarseSide, kCoarseCells);
   block.settle();
   const Vec3 centroid = block.topTriangleCentroid();
   const Vec3 pressed = centroid + Vec3(0.0f, 0.5f * kSmallRadius, 0.0f);  // 5 mm into the face

@@ -72,12 +72,7 @@ std::string csvHeader(const std::vector<std::string>& fingers) {
 
 using testing::TempDir;
 
-std::string readFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using testing::readBytes;
 
 std::vector<std::string> splitLines(const std::string& text) {
   std::vector<std::string> lines;
@@ -154,7 +149,7 @@ TEST(CsvRecorder, HeaderAndRowsForG1Hand) {
     recorder.send(makeSample(1.0 / 60.0, kG1, 0.5f));
     EXPECT_FALSE(recorder.failed());
   }
-  const auto lines = splitLines(readFile(path));
+  const auto lines = splitLines(readBytes(path));
   ASSERT_EQ(lines.size(), 3u);
   EXPECT_EQ(lines[0], header);
   for (int row = 0; row < 2; ++row) {
@@ -188,7 +183,7 @@ TEST(CsvRecorder, HeaderAndRowsForProHand) {
     CsvRecorder recorder(path, kPro);
     recorder.send(makeSample(2.5, kPro));
   }
-  const auto lines = splitLines(readFile(path));
+  const auto lines = splitLines(readBytes(path));
   ASSERT_EQ(lines.size(), 2u);
   EXPECT_EQ(lines[0], csvHeader({"thumb", "index", "middle", "ring", "little"}));
   const auto fields = splitFields(lines[1]);
@@ -214,7 +209,7 @@ TEST(CsvRecorder, WritesNaNAndOutOfRangeValuesClamped) {
     s.tip[2] = Vec3(kInf, kNaN, 0.5f);
     recorder.send(s);
   }
-  const auto lines = splitLines(readFile(path));
+  const auto lines = splitLines(readBytes(path));
   ASSERT_EQ(lines.size(), 2u);
   const auto fields = splitFields(lines[1]);
   ASSERT_EQ(fields.size(), 6u + 3u * 9u);
@@ -250,7 +245,7 @@ TEST(CsvRecorder, FileIsCompleteAfterDestruction) {
     for (int i = 0; i < kRows; ++i) recorder.send(makeSample(i * 0.001, kPro, float(i % 7) / 7.0f));
     EXPECT_GT(fs::file_size(path), 0u);  // whole buffers already went out
   }
-  const auto lines = splitLines(readFile(path));
+  const auto lines = splitLines(readBytes(path));
   ASSERT_EQ(lines.size(), std::size_t(kRows) + 1);
   for (std::size_t i = 1; i < lines.size(); ++i) ASSERT_EQ(splitFields(lines[i]).size(), 51u) << "line " << i;
   EXPECT_EQ(number(splitFields(lines.back())[1]), (kRows - 1) * 0.001);
@@ -261,16 +256,16 @@ TEST(CsvRecorder, FlushesPeriodicallyAndOnRelease) {
   const fs::path path = dir / "flush.csv";
   CsvRecorder every(path, kG1, milliseconds(0));
   every.send(makeSample(0.0, kG1));
-  EXPECT_EQ(splitLines(readFile(path)).size(), 2u);  // in the file while the recorder lives
+  EXPECT_EQ(splitLines(readBytes(path)).size(), 2u);  // in the file while the recorder lives
 
   const fs::path held = dir / "held.csv";
   CsvRecorder hourly(held, kG1, std::chrono::hours(1));
   hourly.release();  // nothing sent yet: no release row
   hourly.send(makeSample(0.25, kG1));
-  EXPECT_EQ(splitLines(readFile(held)).size(), 1u);  // header only, the row waits
+  EXPECT_EQ(splitLines(readBytes(held)).size(), 1u);  // header only, the row waits
   hourly.release();
   hourly.release();  // one release row, not two
-  const auto lines = splitLines(readFile(held));
+  const auto lines = splitLines(readBytes(held));
   ASSERT_EQ(lines.size(), 3u);
   const auto zero = splitFields(lines[2]);
   EXPECT_EQ(zero[0], "15");    // at the last sample's step
@@ -331,7 +326,7 @@ TEST(CsvRecorder, DiskFullDuringRunIsReportedNotThrown) {
   EXPECT_GT(written, 0u);
   EXPECT_LT(written, std::size_t(kRows));
   EXPECT_EQ(written + dropped, std::size_t(kRows) + 1);  // + the release row
-  const std::string text = readFile(path);
+  const std::string text = readBytes(path);
   EXPECT_LE(text.size(), 2000u);
   const auto lines = splitLines(text);  // every line whole: the partial row was cut off
   ASSERT_EQ(lines.size(), written + 1);
@@ -584,7 +579,7 @@ TEST(HapticOutputs, OneSignalToSeveralOutputs) {
   for (auto& out : outputs) out->send(sample);
   for (auto& out : outputs) out->release();
   outputs.clear();
-  const auto lines = splitLines(readFile(dir / "both.csv"));
+  const auto lines = splitLines(readBytes(dir / "both.csv"));
   ASSERT_EQ(lines.size(), 3u);                     // header, the sample, the release
   EXPECT_EQ(splitFields(lines[1])[6 + 9], "0.6");  // index
   const auto got = receiver.take(8);

@@ -1067,10 +1067,7 @@ TEST(WeartParse, HostileBytesAndSizesAreErrors) {
 
 // --- The malformed-frame corpus ------------------------------------------------------------------------
 
-std::string readFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using testing::readBytes;
 
 bool startsWith(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
 
@@ -1080,7 +1077,7 @@ TEST(WeartCorpus, EveryFileParsesAsItsNameSays) {
   std::map<std::string, int> counts;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
-    const std::string frame = readFile(entry.path());
+    const std::string frame = readBytes(entry.path());
     SCOPED_TRACE(name);
     const ParsedMiddleware mw = parseMiddlewareFrame(frame);
     const ParsedClient client = parseClientFrame(frame);
@@ -1137,7 +1134,7 @@ TEST(WeartCorpus, MutatedFramesGiveAMessageOrAnError) {
   int accepted = 0, rejected = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (!startsWith(entry.path().filename().string(), "ok_")) continue;
-    const std::string original = readFile(entry.path());
+    const std::string original = readBytes(entry.path());
     for (int i = 0; i < 500; ++i) {
       std::string frame = original;
       for (int edits = 1 + static_cast<int>(rng() % 4); edits > 0; --edits)

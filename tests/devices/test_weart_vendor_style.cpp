@@ -29,7 +29,7 @@ using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
 constexpr auto kExampleWait = 1s;  // what an example may wait for what it waits for
-constexpr auto kWait = 5s;         // bound of the set-up steps
+constexpr auto kSetupWait = 5s;    // bound of the set-up steps
 
 // One middleware frame as received: its text and what it parses to.
 struct Received {
@@ -77,7 +77,7 @@ class ExampleClient {
   /// What a listener registered after Run() never sees: the frames up to the first one and those
   /// arriving within 50 ms of it.
   bool missTheFirstPush() {
-    if (!waitFor([](const Received&) { return true; }, kWait)) return false;
+    if (!waitFor([](const Received&) { return true; }, kSetupWait)) return false;
     const Clock::time_point until = Clock::now() + 50ms;
     while (Clock::now() < until) read(until - Clock::now());
     pending_.clear();
@@ -171,7 +171,7 @@ TEST(WeartVendorStyle, RawDataOfEveryNodeWithinASecond) {
           const auto* s = r.as<MiddlewareStatus>();
           return s && s->status == "RUNNING";
         },
-        kWait));
+        kSetupWait));
     client.send(pythonRequest("RAW_DATA_ON"));
     std::set<Point> seen;
     const std::string type = f.pro ? "RAW_DATA_TD_PRO" : "RAW_DATA";
@@ -200,7 +200,7 @@ TEST(WeartVendorStyle, ProStatusIsCompleteAndAgreesWithItsDevices) {
         if (r.as<DevicesStatus>()) devices = r;
         return status && devices;
       },
-      kWait));
+      kSetupWait));
   // §7.8's keys, every one of them (the Python SDK reads a missing one as None).
   for (const char* key : {"\"signalStrength\":", "\"sensorsCalibDate\":\"", "\"chargeCompleted\":", "\"bluetoothOn\":",
                           "\"bluetoothConnected\":", "\"wifiOn\":", "\"wifiConnected\":", "\"usbConnected\":",
@@ -249,7 +249,7 @@ TEST(WeartVendorStyle, BareStartStreamsDefaultTrackingOnAG1) {
           }
           return ++frames == 10;
         },
-        kWait));
+        kSetupWait));
     client.send("StopFromClient~");
   }
 }
@@ -267,7 +267,7 @@ TEST(WeartVendorStyle, BareStartOnAProStreamsItsOwnTracking) {
         if (const Tracking* t = r.as<Tracking>(); t && t->hands.size() == 1) ++frames;
         return frames == 10;
       },
-      kWait));
+      kSetupWait));
 }
 
 TEST(WeartVendorStyle, StatusIsRepeatedAtTheSetPeriodAndOnChanges) {
@@ -284,7 +284,7 @@ TEST(WeartVendorStyle, StatusIsRepeatedAtTheSetPeriodAndOnChanges) {
         devices += r.as<DevicesStatus>() != nullptr;
         return statuses >= 10 && devices >= 10;
       },
-      kWait));
+      kSetupWait));
   EXPECT_TRUE(fast.commands().empty());
 
   fs.statusPeriod = 0ms;  // on connect and on change only
@@ -306,7 +306,7 @@ TEST(WeartVendorStyle, StatusIsRepeatedAtTheSetPeriodAndOnChanges) {
         if (const auto* s = r.as<MiddlewareStatus>()) changes.push_back(s->status);
         return !changes.empty() && changes.back() == "RUNNING";
       },
-      kWait));
+      kSetupWait));
   EXPECT_EQ(changes, (std::vector<std::string>{"STARTING", "RUNNING"}));
 }
 
@@ -326,7 +326,7 @@ TEST(WeartVendorStyle, AStartErrorIsRepeatedUntilTheNextStart) {
         refused += s && s->statusCode == 101;
         return refused == 3;  // the reply and two periodic pushes
       },
-      kWait));
+      kSetupWait));
   fake.setStartError(0);
   client.send(kPythonStart);
   ASSERT_TRUE(client.waitFor(
@@ -334,7 +334,7 @@ TEST(WeartVendorStyle, AStartErrorIsRepeatedUntilTheNextStart) {
         const auto* s = r.as<MiddlewareStatus>();
         return s && s->status == "RUNNING" && s->statusCode == 0;
       },
-      kWait));
+      kSetupWait));
 }
 
 // A client that stops reading blocks the fake's writes (for up to a second each); stop() must not

@@ -22,7 +22,7 @@ namespace {
 
 using Mat3d = Mat3T<double>;
 
-const std::filesystem::path kMeshes = std::filesystem::path(VRDEFORM_SHARED_DIR) / "data" / "meshes";
+using testing::kMeshes;
 TriMesh bear() { return readSurface(kMeshes / "bear.obj"); }
 
 double diagonal(const std::vector<Vec3>& points) {

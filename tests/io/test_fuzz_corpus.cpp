@@ -9,17 +9,14 @@
 #include <vector>
 
 #include "fuzz_corpus.h"
+#include "test_support.h"
 #include "vrdeform/io/surface_io.h"
 #include "vrdeform/io/tet_io.h"
 
 namespace vrd {
 namespace {
 
-void writeBytes(const std::filesystem::path& path, std::string_view bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  ASSERT_TRUE(out.good()) << path;
-}
+using testing::writeBytes;
 
 void checkSurfaces(const std::string& format) {
   const testing::TempDir dir;

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <random>
 
+#include "test_support.h"
 #include "vrdeform/error.h"
 #include "vrdeform/io/surface_io.h"
 #include "vrdeform/mesh/primitives.h"
@@ -13,7 +14,7 @@ namespace vrd {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path kMeshes = fs::path(VRDEFORM_SHARED_DIR) / "data" / "meshes";
+using testing::kMeshes;
 
 class SurfaceIo : public ::testing::Test {
  protected:
@@ -40,10 +41,7 @@ TriMesh octahedron() {
   return m;
 }
 
-std::string readBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
+using testing::readBytes;
 
 void expectSameMesh(const TriMesh& a, const TriMesh& b) {
   ASSERT_EQ(a.vertices.size(), b.vertices.size());

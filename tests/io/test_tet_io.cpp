@@ -33,20 +33,8 @@ namespace fs = std::filesystem;
 using testing::TempDir;
 const fs::path kTetMeshes = fs::path(VRDEFORM_SHARED_DIR) / "data" / "meshes" / "tet";
 
-void writeBytes(const fs::path& path, std::string_view bytes) {
-  // A new file rather than a truncated one: ext4 flushes a file rewritten after truncation when it is
-  // closed, which costs milliseconds each time.
-  fs::remove(path);
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
-
-std::string readBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using testing::readBytes;
+using testing::writeBytes;
 
 using testing::errorOf;
 

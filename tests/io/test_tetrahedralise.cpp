@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 
+#include "test_support.h"
 #include "vrdeform/error.h"
 #include "vrdeform/io/surface_io.h"
 #include "vrdeform/io/tetrahedralise.h"
@@ -23,7 +24,7 @@ namespace vrd {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path kMeshes = fs::path(VRDEFORM_SHARED_DIR) / "data" / "meshes";
+using testing::kMeshes;
 const char* const kClosedMeshes[] = {
     "bear_coarse.obj",   "bunny_coarse.obj", "liver_coarse.obj", "jelly_blobby_coarse.obj",
     "sphere_coarse.obj", "sphere.obj",       "bear.obj",         "bunny.obj",

@@ -20,7 +20,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
-BuiltScene liver() {
+BuiltScene controlledLiver() {
   SceneSpec spec = loadSceneByName("liver");
   spec.solver.timeStep = 1e-3;
   spec.settle = 0.0;
@@ -49,7 +49,7 @@ SimulationLoopSettings asFastAsItCan() {
 
 // The liver's loop, started paused, with one reader.
 struct PausedLoop {
-  BuiltScene scene = liver();
+  BuiltScene scene = controlledLiver();
   SimulationLoop loop{scene, asFastAsItCan()};
   std::shared_ptr<SnapshotChannel> view = loop.subscribe();
   PausedLoop() {
@@ -103,7 +103,7 @@ TEST(LoopControls, SnapshotsCarryConstraintForcesOnlyWhenAsked) {
 }
 
 TEST(LoopControls, SolverSettingsChangeBetweenSteps) {
-  BuiltScene scene = liver();
+  BuiltScene scene = controlledLiver();
   SimulationLoopSettings settings;
   settings.realTime = false;
   SimulationLoop loop(scene, settings);
@@ -125,7 +125,7 @@ TEST(LoopControls, SolverSettingsChangeBetweenSteps) {
 }
 
 TEST(LoopControls, LiveHandMovesTheFingertipsFromAnotherThread) {
-  BuiltScene scene = liver();
+  BuiltScene scene = controlledLiver();
   HandFrame parked;
   parked.direct = true;
   for (int f = 0; f < kFingerCount; ++f) parked.fingertips[f] = Vec3(0.1f * f, 1.0f, 0.0f);

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <string>
 
+#include "test_support.h"
 #include "vrdeform/core/write_file.h"
 #include "vrdeform/error.h"
 #include "vrdeform/study/study_analysis.h"
@@ -45,16 +46,16 @@ id = "D1"
 text = "Which was better?"
 )";
 
-struct Folder {
+struct DataFolder {
   fs::path path;
-  Folder()
+  DataFolder()
       : path(fs::temp_directory_path() /
              ("vrdeform_study_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
               ::testing::UnitTest::GetInstance()->current_test_info()->name())) {
     fs::remove_all(path);
     fs::create_directories(path);
   }
-  ~Folder() { fs::remove_all(path); }
+  ~DataFolder() { fs::remove_all(path); }
 };
 
 // Five participants: H1 in A is 2 above B for everyone but P5 (equal), H2 1 below for P1 and P2,
@@ -65,7 +66,7 @@ void writeData(const fs::path& dir) {
   const int v1a[] = {5, 5, 5, 5, 5}, v1b[] = {6, 4, 0, 7, 3};
   const int d1[] = {-3, -2, -1, 0, -2};
   for (int k = 0; k < 5; ++k) {
-    const fs::path p = dir / ("P" + std::to_string(k + 1));
+    const fs::path p = testing::participantFolder(dir, k + 1);
     fs::create_directories(p);
     std::string answers = "condition,item,answer\n";
     answers += "A,H1," + std::to_string(h1a[k]) + "\nB,H1," + std::to_string(h1b[k]) + "\n";
@@ -78,7 +79,7 @@ void writeData(const fs::path& dir) {
 }
 
 TEST(StudyAnalysis, DescribesAndTestsEveryItemAndDimension) {
-  Folder data;
+  DataFolder data;
   writeData(data.path);
   const StudySpec study = parseStudy(kStudy, "two.toml", ".");
   const std::vector<ParticipantAnswers> people = readStudyAnswers(study, data.path);
@@ -158,7 +159,7 @@ TEST(StudyAnalysis, DescribesAndTestsEveryItemAndDimension) {
   EXPECT_EQ(rows, 5 * 6 - 1);  // every answer once
 }
 
-std::string errorOf(const fs::path& dir, const std::string& answers) {
+std::string analysisError(const fs::path& dir, const std::string& answers) {
   writeFile(dir / "P1" / "answers.csv", answers);
   try {
     readStudyAnswers(parseStudy(kStudy, "two.toml", "."), dir);
@@ -176,7 +177,7 @@ TEST(StudyAnalysis, FreeTextIsKeptAsWritten) {
                                          "[[free_text]]\nid = \"F1\"\ntext = \"What did you feel?\"\n"
                                          "[[free_text]]\nid = \"F2\"\ntext = \"Anything else?\"\nafter = \"study\"\n",
                                      "two.toml", ".");
-  Folder data;
+  DataFolder data;
   writeData(data.path);
   writeFile(data.path / "P2" / "free_text.json",
             R"([{"item": "F1", "condition": "B", "text": "Firm, then \"stepped\"\nat the end"},
@@ -225,17 +226,19 @@ TEST(StudyAnalysis, FreeTextIsKeptAsWritten) {
 }
 
 TEST(StudyAnalysis, BadAnswersAreNamedWithFileAndLine) {
-  Folder data;
+  DataFolder data;
   fs::create_directories(data.path / "P1");
-  EXPECT_EQ(errorOf(data.path, "condition,item,answer\nA,H1,8\n"),
+  EXPECT_EQ(analysisError(data.path, "condition,item,answer\nA,H1,8\n"),
             "answers.csv:2: answer '8' is not an integer in 1..7");
-  EXPECT_EQ(errorOf(data.path, "condition,item,answer\nA,H9,3\n"), "answers.csv:2: no question 'H9' in the study");
-  EXPECT_EQ(errorOf(data.path, "condition,item,answer\nC,H1,3\n"), "answers.csv:2: no condition 'C' in the study");
-  EXPECT_EQ(errorOf(data.path, "condition,item,answer\nA,H1,3\n\nA,H1,4\n"),
+  EXPECT_EQ(analysisError(data.path, "condition,item,answer\nA,H9,3\n"),
+            "answers.csv:2: no question 'H9' in the study");
+  EXPECT_EQ(analysisError(data.path, "condition,item,answer\nC,H1,3\n"),
+            "answers.csv:2: no condition 'C' in the study");
+  EXPECT_EQ(analysisError(data.path, "condition,item,answer\nA,H1,3\n\nA,H1,4\n"),
             "answers.csv:4: a second answer to H1 in condition A");
-  EXPECT_EQ(errorOf(data.path, "condition,item\nA,H1\n"),
+  EXPECT_EQ(analysisError(data.path, "condition,item\nA,H1\n"),
             "answers.csv:1: expected 3 comma-separated fields (condition,item,answer), got 2");
-  EXPECT_EQ(errorOf(data.path, "item,condition,answer\n"),
+  EXPECT_EQ(analysisError(data.path, "item,condition,answer\n"),
             "answers.csv:1: expected the header 'condition,item,answer'");
   writeFile(data.path / "P1" / "answers.csv", "condition,item,answer\n");
   writeFile(data.path / "P1" / "comparisons.csv", "item,rating\nD1,4\n");

@@ -38,7 +38,7 @@ text = "Which was better?"
 between = ["C", "A"]
 )";
 
-std::string errorOf(const std::string& text) {
+std::string studyError(const std::string& text) {
   try {
     parseStudy(text, "s.toml", ".");
   } catch (const Error& e) {
@@ -85,11 +85,11 @@ TEST(StudyFile, FreeTextItemsAreAskedAfterEachConditionOrOnce) {
   EXPECT_EQ(s.freeTexts[0].text, "What did you feel?");
   EXPECT_TRUE(s.freeTexts[0].perCondition);
   EXPECT_FALSE(s.freeTexts[1].perCondition);
-  EXPECT_EQ(errorOf(std::string(kSmall) + "[[free_text]]\nid = \"D1\"\ntext = \"x\"\n"),
+  EXPECT_EQ(studyError(std::string(kSmall) + "[[free_text]]\nid = \"D1\"\ntext = \"x\"\n"),
             "s.toml:24: free_text[1].id: 'D1' is the id of an earlier entry too");
-  EXPECT_EQ(errorOf(std::string(kSmall) + "[[free_text]]\nid = \"F1\"\ntext = \"x\"\nafter = \"trial\"\n"),
+  EXPECT_EQ(studyError(std::string(kSmall) + "[[free_text]]\nid = \"F1\"\ntext = \"x\"\nafter = \"trial\"\n"),
             "s.toml:26: free_text[1].after: unknown value 'trial' (expected one of: condition, study)");
-  EXPECT_EQ(errorOf(std::string(kSmall) + "[[free_text]]\nid = \"F1\"\n"), "s.toml:23: free_text[1].text: missing");
+  EXPECT_EQ(studyError(std::string(kSmall) + "[[free_text]]\nid = \"F1\"\n"), "s.toml:23: free_text[1].text: missing");
 }
 
 // A practice trial on the first condition's scene unless it names its own.
@@ -105,9 +105,9 @@ TEST(StudyFile, APracticeTrialComesFirst) {
   EXPECT_EQ(parseStudy(std::string(kSmall) + "[practice]\nscene = \"jelly\"\nforce = \"baseline\"\n", "s.toml", ".")
                 .practice->condition.scene,
             "jelly");
-  EXPECT_EQ(errorOf(std::string(kSmall) + "[practice]\nscene = \"jely\"\n").substr(0, 40),
+  EXPECT_EQ(studyError(std::string(kSmall) + "[practice]\nscene = \"jely\"\n").substr(0, 40),
             "s.toml:24: practice.scene: no built-in s");
-  EXPECT_EQ(errorOf(std::string(kSmall) + "[practice]\ntrials = 2\n"),
+  EXPECT_EQ(studyError(std::string(kSmall) + "[practice]\ntrials = 2\n"),
             "s.toml:24: practice.trials: unknown key (expected one of: scene, force, seconds, instructions)");
 }
 
@@ -116,7 +116,7 @@ TEST(StudyFile, MistakesAreNamedWithLineAndKey) {
   const auto with = [&](const std::string& from, const std::string& to) {
     std::string text = small;
     text.replace(text.find(from), from.size(), to);
-    return errorOf(text);
+    return studyError(text);
   };
   EXPECT_EQ(with("name = \"small\"", "name = \"small\"\ntrails = 3"),
             "s.toml:3: trails: unknown key (did you mean 'trials'?)");
@@ -135,15 +135,16 @@ TEST(StudyFile, MistakesAreNamedWithLineAndKey) {
   EXPECT_EQ(with("force = \"baseline\"", "force = \"vendor\""),
             "s.toml:9: condition[2].force: unknown value 'vendor' (expected one of: multipliers, baseline)");
   EXPECT_EQ(with("name = \"small\"", "name = \"small\"\npoints = 1"), "s.toml:3: points: must be in 2..11, got 1");
-  EXPECT_EQ(errorOf("format = 1\nname = \"x\"\n[[condition]]\nname = \"A\"\nscene = \"liver\"\n"),
+  EXPECT_EQ(studyError("format = 1\nname = \"x\"\n[[condition]]\nname = \"A\"\nscene = \"liver\"\n"),
             "s.toml:3: condition: a within-subject study needs two or more [[condition]]s");
-  EXPECT_EQ(errorOf("format = 1\nname = \"x\"\n[[condition]]\nname = \"A\"\nscene = \"liver\"\n[[condition]]\nname = "
-                    "\"B\"\nscene = \"liver\"\n"),
-            "s.toml:1: task: needs at least one [[task]]");
-  EXPECT_EQ(errorOf("format = 1\nname = \"x\"\n[[condition]]\nname = \"A\"\nscene = \"nope/s.toml\"\n"),
+  EXPECT_EQ(
+      studyError("format = 1\nname = \"x\"\n[[condition]]\nname = \"A\"\nscene = \"liver\"\n[[condition]]\nname = "
+                 "\"B\"\nscene = \"liver\"\n"),
+      "s.toml:1: task: needs at least one [[task]]");
+  EXPECT_EQ(studyError("format = 1\nname = \"x\"\n[[condition]]\nname = \"A\"\nscene = \"nope/s.toml\"\n"),
             "s.toml:5: condition[1].scene: no such file '" +
                 (std::filesystem::current_path() / "nope/s.toml").lexically_normal().string() + "'");
-  EXPECT_EQ(errorOf("format = 1\nname = [\n"),
+  EXPECT_EQ(studyError("format = 1\nname = [\n"),
             "s.toml:2: TOML syntax: Error while parsing array: encountered end-of-file");
 }
 

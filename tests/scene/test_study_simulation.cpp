@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "test_support.h"
 #include "vrdeform/error.h"
 #include "vrdeform/metrics/latin_square.h"
 #include "vrdeform/study/study_analysis.h"
@@ -20,7 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // The liver's poke (4.3 s with its release) under each condition, one trial each.
-constexpr const char* kStudy = R"(format = 1
+constexpr const char* kSimulatedStudy = R"(format = 1
 name = "poke"
 trials = 1
 [[condition]]
@@ -57,18 +58,15 @@ text = "Which felt best?"
 after = "study"
 )";
 
-struct Folder {
+struct RunFolder {
   fs::path path;
-  explicit Folder(const std::string& name) : path(fs::temp_directory_path() / ("vrdeform_study_sim_" + name)) {
+  explicit RunFolder(const std::string& name) : path(fs::temp_directory_path() / ("vrdeform_study_sim_" + name)) {
     fs::remove_all(path);
   }
-  ~Folder() { fs::remove_all(path); }
+  ~RunFolder() { fs::remove_all(path); }
 };
 
-std::string read(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
+using testing::readBytes;
 
 bool anyPartial(const fs::path& dir) {
   for (const auto& e : fs::recursive_directory_iterator(dir))
@@ -77,8 +75,8 @@ bool anyPartial(const fs::path& dir) {
 }
 
 TEST(StudySimulation, FourParticipantsRunTheStudyInTheirOrders) {
-  const StudySpec study = parseStudy(kStudy, "poke.toml", ".");
-  Folder data("four");
+  const StudySpec study = parseStudy(kSimulatedStudy, "poke.toml", ".");
+  RunFolder data("four");
   for (std::size_t k = 1; k <= 4; ++k) {
     StudyRunSettings s;
     s.dataDir = data.path;
@@ -86,13 +84,14 @@ TEST(StudySimulation, FourParticipantsRunTheStudyInTheirOrders) {
     const StudyRunResult r = runSimulatedParticipant(study, s);
     EXPECT_EQ(r.trialsRun, 2u);
     EXPECT_EQ(r.trialsKept, 0u);
-    const nlohmann::json who = nlohmann::json::parse(read(data.path / ("P" + std::to_string(k)) / "participant.json"));
+    const nlohmann::json who =
+        nlohmann::json::parse(readBytes(testing::participantFolder(data.path, k) / "participant.json"));
     const std::vector<std::size_t> order = latinSquareOrder(2, k - 1);
     ASSERT_EQ(who["order"].size(), 2u);
     for (std::size_t pos = 0; pos < 2; ++pos) {
       EXPECT_EQ(who["order"][pos], study.conditions[order[pos]].name) << "P" << k << " position " << pos + 1;
-      const nlohmann::json trial = nlohmann::json::parse(
-          read(data.path / ("P" + std::to_string(k)) / "trials" / (std::to_string(pos + 1) + "-1-1") / "trial.json"));
+      const nlohmann::json trial = nlohmann::json::parse(readBytes(testing::participantFolder(data.path, k) / "trials" /
+                                                                   (std::to_string(pos + 1) + "-1-1") / "trial.json"));
       EXPECT_EQ(trial["condition"], study.conditions[order[pos]].name);
     }
   }
@@ -125,8 +124,8 @@ TEST(StudySimulation, FourParticipantsRunTheStudyInTheirOrders) {
 // The practice trial runs first, into its own folder, is kept on a second run and is not analysed.
 TEST(StudySimulation, ThePracticeTrialComesFirstAndIsKept) {
   const StudySpec study =
-      parseStudy(std::string(kStudy) + "[practice]\nscene = \"jelly\"\nseconds = 0.5\n", "practice.toml", ".");
-  Folder data("practice");
+      parseStudy(std::string(kSimulatedStudy) + "[practice]\nscene = \"jelly\"\nseconds = 0.5\n", "practice.toml", ".");
+  RunFolder data("practice");
   StudyRunSettings s;
   s.dataDir = data.path;
   std::vector<std::string> log;
@@ -134,7 +133,7 @@ TEST(StudySimulation, ThePracticeTrialComesFirstAndIsKept) {
   EXPECT_EQ(runSimulatedParticipant(study, s).trialsRun, 3u);
   ASSERT_FALSE(log.empty());
   EXPECT_EQ(log.front(), "P1: practice");
-  const nlohmann::json trial = nlohmann::json::parse(read(data.path / "P1" / "practice" / "trial.json"));
+  const nlohmann::json trial = nlohmann::json::parse(readBytes(data.path / "P1" / "practice" / "trial.json"));
   EXPECT_EQ(trial["condition"], "practice");
   EXPECT_EQ(trial["scene"], "jelly");
   EXPECT_EQ(trial["steps"], 30);
@@ -145,8 +144,8 @@ TEST(StudySimulation, ThePracticeTrialComesFirstAndIsKept) {
 }
 
 TEST(StudySimulation, AStoppedRunResumesKeepingEveryFinishedTrial) {
-  const StudySpec study = parseStudy(kStudy, "poke.toml", ".");
-  Folder data("resumed"), whole("whole");
+  const StudySpec study = parseStudy(kSimulatedStudy, "poke.toml", ".");
+  RunFolder data("resumed"), whole("whole");
   StudyRunSettings s;
   s.dataDir = data.path;
   s.participant = 2;
@@ -159,20 +158,20 @@ TEST(StudySimulation, AStoppedRunResumesKeepingEveryFinishedTrial) {
   EXPECT_FALSE(fs::exists(data.path / "P2" / "trials" / "2-1-1"));
   EXPECT_FALSE(anyPartial(data.path));
   EXPECT_FALSE(fs::exists(data.path / "P2" / "answers.csv"));
-  const std::string kept = read(first / "trial.json");
+  const std::string kept = readBytes(first / "trial.json");
   const fs::file_time_type keptTime = fs::last_write_time(first / "trial.json");
 
   s.stop = nullptr;
   const StudyRunResult r = runSimulatedParticipant(study, s);
   EXPECT_EQ(r.trialsKept, 1u);
   EXPECT_EQ(r.trialsRun, 1u);
-  EXPECT_EQ(read(first / "trial.json"), kept);
+  EXPECT_EQ(readBytes(first / "trial.json"), kept);
   EXPECT_EQ(fs::last_write_time(first / "trial.json"), keptTime);
 
   s.dataDir = whole.path;  // the same participant in one go answers the same
   runSimulatedParticipant(study, s);
-  EXPECT_EQ(read(data.path / "P2" / "answers.csv"), read(whole.path / "P2" / "answers.csv"));
-  EXPECT_EQ(read(data.path / "P2" / "comparisons.csv"), read(whole.path / "P2" / "comparisons.csv"));
+  EXPECT_EQ(readBytes(data.path / "P2" / "answers.csv"), readBytes(whole.path / "P2" / "answers.csv"));
+  EXPECT_EQ(readBytes(data.path / "P2" / "comparisons.csv"), readBytes(whole.path / "P2" / "comparisons.csv"));
 
   fs::remove(first / "trial.json");  // a broken record is named, not run over
   { std::ofstream(first / "trial.json") << "{\"felt\": 1}"; }

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "test_support.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/mesh/surface_check.h"
 #include "vrdeform/sim/world.h"
@@ -13,7 +14,7 @@
 namespace vrd {
 namespace {
 
-constexpr float kG = 9.81f;
+using testing::kG;
 
 std::shared_ptr<const BodyModel> block(const Vec3& size, int nx, int ny, int nz, float youngs,
                                        float density = 1000.0f) {

@@ -16,28 +16,26 @@
 #include <memory>
 #include <vector>
 
+#include "test_support.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/world.h"
 
 namespace vrd {
 namespace {
 
-constexpr float kG = 10.0f;
+constexpr float kChainG = 10.0f;
 constexpr int kParticles = 20;  // the top one fixed
 constexpr int kHanging = kParticles - 1;
-constexpr float kSettleDamping = 10.0f;  // 1/s: the slowest chain modes (4-8 rad/s) decay at >= 2/s
+constexpr float kChainSettleDamping = 10.0f;  // 1/s: the slowest chain modes (4-8 rad/s) decay at >= 2/s
 
-double ulp(float x) {
-  const float a = std::fabs(x);
-  return double(std::nextafter(a, std::numeric_limits<float>::infinity())) - double(a);
-}
+using testing::ulp;
 
 SolverSettings settings(int substeps, int iterations, float damping, float timeStep = 1.0f / 60.0f) {
   SolverSettings s;
   s.timeStep = timeStep;
   s.substeps = substeps;
   s.iterations = iterations;
-  s.gravity = Vec3(0.0f, -kG, 0.0f);
+  s.gravity = Vec3(0.0f, -kChainG, 0.0f);
   s.linearDamping = damping;
   s.timeStages = false;
   return s;
@@ -107,10 +105,10 @@ struct Hanging {
 // gravity, so no static bias, docs/validation.md P4).
 Hanging hangChain(float link, float compliance, int substeps, int iterations, float timeStep = 1.0f / 60.0f,
                   double seconds = 10.0) {
-  World w(settings(substeps, iterations, kSettleDamping, timeStep));
+  World w(settings(substeps, iterations, kChainSettleDamping, timeStep));
   const BodyId b = w.addBody(chainModel(link, compliance, Vec3(0.0f, -1.0f, 0.0f)));
   for (long k = std::lround(seconds / timeStep); k > 0; --k) w.step();
-  const double h = w.substepSize(), h2g = h * h * kG;
+  const double h = w.substepSize(), h2g = h * h * kChainG;
   Hanging r{-double(w.body(b).distanceLambda[0]) / (h * h), chainExtension(w, b), 0.0, 0.0};
   for (int i = 1; i < kParticles; ++i) {
     const double e = ulp(w.particles().x[w.particleIndex(b, Index(i))].pos.y()) / h2g;
@@ -133,7 +131,7 @@ struct Split {
 // links and any split, or twice the float bound mean_i ulp(y_i)/(h^2 g) where that is larger
 // (h = 1/1200 s: ~1e-3 for a chain reaching y = -0.2 m; h = 1/60 s: ~1e-5).
 TEST(Chain, SupportForceEqualsHangingWeight) {
-  const double weight = kHanging * 1.0 * kG;
+  const double weight = kHanging * 1.0 * kChainG;
   for (float alpha : {0.0f, 1e-4f})
     for (Split s : {Split{1, 1}, Split{1, 20}, Split{20, 1}, Split{5, 4}}) {
       const Hanging r = hangChain(0.01f, alpha, s.substeps, s.iterations);
@@ -148,7 +146,7 @@ TEST(Chain, SupportForceEqualsHangingWeight) {
 // (docs/validation.md V3) once the budget is >= 20 substeps or >= 20 iterations.
 TEST(Chain, CompliantStretch) {
   constexpr float alpha = 1e-4f;
-  const double expected = double(alpha) * 1.0 * kG * kHanging * (kHanging + 1) / 2.0;
+  const double expected = double(alpha) * 1.0 * kChainG * kHanging * (kHanging + 1) / 2.0;
   for (Split s : {Split{20, 1}, Split{1, 20}, Split{1, 100}}) {
     const Hanging r = hangChain(0.01f, alpha, s.substeps, s.iterations);
     const double tol = std::max(1e-2, 2.0 * r.floatWorst);
@@ -256,10 +254,10 @@ void budgetExperiment(const Scene& scene) {
     double stretch[3], loss[3];
     for (int k = 0; k < 3; ++k) {
       const Split s = splits(budget)[k];
-      SCOPED_TRACE(testing::Message() << scene.name << ", B = " << budget << ": " << s.substeps << " substeps x "
-                                      << s.iterations << " iterations");
+      SCOPED_TRACE(::testing::Message() << scene.name << ", B = " << budget << ": " << s.substeps << " substeps x "
+                                        << s.iterations << " iterations");
       {
-        World w(settings(s.substeps, s.iterations, kSettleDamping));
+        World w(settings(s.substeps, s.iterations, kChainSettleDamping));
         const BodyId b = scene.make(w, true);
         for (int step = 0; step < 240; ++step) w.step();
         stretch[k] = scene.error(w, b);
@@ -270,7 +268,7 @@ void budgetExperiment(const Scene& scene) {
       loss[k] = t.loss;
       EXPECT_LE(t.worstExcess, 0.0) << "energy rose above its start";
     }
-    SCOPED_TRACE(testing::Message() << scene.name << ", B = " << budget);
+    SCOPED_TRACE(::testing::Message() << scene.name << ", B = " << budget);
     EXPECT_LT(stretch[0], stretch[1]);
     EXPECT_LT(stretch[1], stretch[2]);
     EXPECT_LT(loss[0], loss[1]);

@@ -20,8 +20,8 @@
 namespace vrd {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kG = 9.81;
+using std::numbers::pi;
+constexpr double kPendulumG = 9.81;
 
 // The complete elliptic integral of the first kind K(k), by the arithmetic-geometric mean.
 double ellipticK(double k) {
@@ -31,7 +31,7 @@ double ellipticK(double k) {
     b = std::sqrt(a * b);
     a = next;
   }
-  return kPi / (2.0 * a);
+  return pi / (2.0 * a);
 }
 
 struct PendulumRun {
@@ -43,12 +43,12 @@ struct PendulumRun {
 // A kinematic pivot at `pivot` and a 1 kg bob on a hard distance constraint of 1 m, released at
 // 5 degrees, 1 iteration per substep; `seconds` of swinging.
 PendulumRun swing(int substeps, const Vec3& pivot, double seconds) {
-  constexpr double kLength = 1.0, kTheta0 = 5.0 * kPi / 180.0;
+  constexpr double kLength = 1.0, kTheta0 = 5.0 * pi / 180.0;
   SolverSettings s;
   s.timeStep = 1.0 / 60.0;
   s.substeps = substeps;
   s.iterations = 1;
-  s.gravity = Vec3(0.0f, -float(kG), 0.0f);
+  s.gravity = Vec3(0.0f, -float(kPendulumG), 0.0f);
   s.linearDamping = 0.0f;
   s.timeStages = false;
   s.measureResiduals = false;
@@ -63,7 +63,7 @@ PendulumRun swing(int substeps, const Vec3& pivot, double seconds) {
   const Vec3d top = w.position(0);
   const auto energy = [&] {
     const Vec3d bob = w.position(1) - top;
-    return 0.5 * w.particles().v[1].cast<double>().squaredNorm() + kG * (bob.y() + kLength);
+    return 0.5 * w.particles().v[1].cast<double>().squaredNorm() + kPendulumG * (bob.y() + kLength);
   };
   std::vector<double> crossings, energies;
   double t = 0.0, before = (w.position(1) - top).x();
@@ -84,8 +84,8 @@ PendulumRun swing(int substeps, const Vec3& pivot, double seconds) {
 }
 
 TEST(Precision, APendulumKeepsItsPeriodAndItsImplicitDampingAtAnySubstepAnywhere) {
-  const double exact = 4.0 * std::sqrt(1.0 / kG) * ellipticK(std::sin(5.0 * kPi / 360.0));  // 2.00702 s
-  const double w2 = kG;                                                                     // w^2 = g / L
+  const double exact = 4.0 * std::sqrt(1.0 / kPendulumG) * ellipticK(std::sin(5.0 * pi / 360.0));  // 2.00702 s
+  const double w2 = kPendulumG;                                                                    // w^2 = g / L
   for (const Vec3& pivot : {Vec3(0, 0, 0), Vec3(100, 100, 100)})
     for (int substeps : {5, 10, 20, 50, 100}) {
       const PendulumRun r = swing(substeps, pivot, 20.0);
@@ -162,7 +162,7 @@ TEST(Precision, ARestingParticleReadsItsWeightAtAnyHeight) {
       w.step();
       if (k >= 1000) sum += double(w.particleConstraintForces(body)[0].y());
     }
-    EXPECT_NEAR(sum / 1000.0, 0.005 * kG, 1e-4 * 0.005 * kG) << "at " << height << " m";
+    EXPECT_NEAR(sum / 1000.0, 0.005 * kPendulumG, 1e-4 * 0.005 * kPendulumG) << "at " << height << " m";
   }
 }
 

@@ -16,18 +16,15 @@
 #include <numbers>
 #include <vector>
 
+#include "test_support.h"
 #include "vrdeform/sim/world.h"
 
 namespace vrd {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using std::numbers::pi;
 
-// Spacing of the float grid at x (one ulp).
-double ulp(float x) {
-  const float a = std::fabs(x);
-  return double(std::nextafter(a, std::numeric_limits<float>::infinity())) - double(a);
-}
+using testing::ulp;
 
 // ----------------------------------------------------------------------------------------------
 // V1: m = 1 kg on a distance constraint to a fixed particle at the origin, rest length 1,
@@ -36,7 +33,7 @@ double ulp(float x) {
 constexpr float kSpringCompliance = 1e-3f;
 constexpr double kA0 = 0.5;                                        // initial displacement x0 - rest (m)
 const double kOmega = 1.0 / std::sqrt(double(kSpringCompliance));  // sqrt(k/m) = 31.62 rad/s
-const double kPeriod = 2.0 * kPi / kOmega;                         // 0.19869 s
+const double kPeriod = 2.0 * pi / kOmega;                          // 0.19869 s
 constexpr double kFloatTol = 1e-4;                                 // docs/validation.md V1: float trajectories
 
 struct Trajectory {
@@ -261,8 +258,8 @@ TEST(Spring, StaticElongationAndForceAnySettings) {
       for (int iterations : {1, 5, 20}) {
         const Static r = hangSprings({mass}, alpha, substeps, iterations);
         const double f = double(mass) * kGravity, stretch = double(alpha) * f;
-        SCOPED_TRACE(testing::Message() << "m = " << mass << " kg, " << substeps << " substeps x " << iterations
-                                        << " iterations, tolerance " << r.tol[0]);
+        SCOPED_TRACE(::testing::Message() << "m = " << mass << " kg, " << substeps << " substeps x " << iterations
+                                          << " iterations, tolerance " << r.tol[0]);
         EXPECT_NEAR(r.stretch[0], stretch, r.tol[0] * stretch);
         EXPECT_NEAR(r.force[0], f, r.tol[0] * f);
       }
@@ -281,7 +278,7 @@ TEST(Spring, MassRatioStretchProportionalToForce) {
     const Static r = hangSprings({m1, m2}, alpha, 20, 10);
     const double force[2] = {double(m1 + m2) * kGravity, double(m2) * kGravity};
     for (int c = 0; c < 2; ++c) {
-      SCOPED_TRACE(testing::Message() << "alpha = " << alpha << ", link " << c << ", tolerance " << r.tol[c]);
+      SCOPED_TRACE(::testing::Message() << "alpha = " << alpha << ", link " << c << ", tolerance " << r.tol[c]);
       EXPECT_NEAR(r.force[c], force[c], r.tol[c] * force[c]);
       EXPECT_NEAR(r.stretch[c] / r.force[c], double(alpha), r.tol[c] * alpha);
     }

@@ -40,7 +40,8 @@ namespace {
 
 using testing::record;
 
-constexpr float kSize = 0.1f, kE = 1e4f, kRho = 1000.0f, kG = 9.81f;
+using testing::kG;
+constexpr float kSize = 0.1f, kE = 1e4f, kRho = 1000.0f;
 
 struct Hanging {
   std::vector<Vec3> x;  // settled positions

@@ -30,7 +30,7 @@ namespace {
 
 using testing::record;
 
-constexpr float kSize = 0.1f;
+constexpr float kCubeEdge = 0.1f;
 
 struct VolumeStats {
   double sumAbsError = 0;  // sum |V_e| / sum V0 - 1
@@ -60,8 +60,8 @@ VolumeStats volumeStats(const World& world, BodyId id) {
 std::shared_ptr<const BodyModel> incompressibleCube() {
   Material material;
   material.elastic = ElasticModuli{1e4f, 0.3f, 1000.0f};
-  const auto base = makeSoftBody(makeBoxTets(Vec3::Constant(-0.5f * kSize), Vec3::Constant(kSize), 4, 4, 4), material,
-                                 ConstraintSet{false, true, true, false});
+  const auto base = makeSoftBody(makeBoxTets(Vec3::Constant(-0.5f * kCubeEdge), Vec3::Constant(kCubeEdge), 4, 4, 4),
+                                 material, ConstraintSet{false, true, true, false});
   auto model = std::make_shared<BodyModel>(*base);
   for (VolumeConstraint& c : model->volume) c.compliance = 0.0f;
   EXPECT_EQ(model->volume.size(), 384u);
@@ -83,7 +83,7 @@ TEST(Volume, ZeroComplianceCubeDroppedAndSquashed) {
   const auto model = incompressibleCube();
   World world(settings20());
   world.addCollider(Collider::plane(Vec3::UnitY()));
-  const BodyId body = world.addBody(model, Vec3(0, 0.5f * kSize + 0.05f, 0));
+  const BodyId body = world.addBody(model, Vec3(0, 0.5f * kCubeEdge + 0.05f, 0));
   const float radius = 0.03f, depth = 0.02f;
   const FingertipId finger = world.addFingertip(Vec3(0, 0.3f, 0), radius, 0.0f);
 
@@ -91,8 +91,9 @@ TEST(Volume, ZeroComplianceCubeDroppedAndSquashed) {
   std::vector<Index> topFace;
   Index topCentre = 0;
   for (Index i = 0; i < model->particleCount(); ++i) {
-    if (model->restPositions[i].y() > 0.5f * kSize - 1e-6f) topFace.push_back(world.particleIndex(body, i));
-    if ((model->restPositions[i] - Vec3(0, 0.5f * kSize, 0)).norm() < 1e-6f) topCentre = world.particleIndex(body, i);
+    if (model->restPositions[i].y() > 0.5f * kCubeEdge - 1e-6f) topFace.push_back(world.particleIndex(body, i));
+    if ((model->restPositions[i] - Vec3(0, 0.5f * kCubeEdge, 0)).norm() < 1e-6f)
+      topCentre = world.particleIndex(body, i);
   }
 
   VolumeStats worst;
@@ -107,7 +108,7 @@ TEST(Volume, ZeroComplianceCubeDroppedAndSquashed) {
 
   for (int k = 0; k < 60; ++k) step();  // fall 5 cm (impact at 1 m/s) and settle: 1 s
   const float settledTop = world.particles().x[topCentre].pos.y();
-  ASSERT_LT(settledTop, kSize + 1e-3f) << "the cube should rest on the ground";
+  ASSERT_LT(settledTop, kCubeEdge + 1e-3f) << "the cube should rest on the ground";
   std::vector<float> topBefore;
   for (Index i : topFace) topBefore.push_back(world.particles().x[i].pos.y());
   const Vec3 touch(0, settledTop + radius, 0);
@@ -159,7 +160,7 @@ TEST(Volume, NoDriftWhileResting) {
   const auto model = incompressibleCube();
   World world(settings20());
   world.addCollider(Collider::plane(Vec3::UnitY()));
-  const BodyId body = world.addBody(model, Vec3(0, 0.5f * kSize, 0));  // resting on the ground
+  const BodyId body = world.addBody(model, Vec3(0, 0.5f * kCubeEdge, 0));  // resting on the ground
   double lossAt1s = 0, worstLoss = 0, worstElement = 0;
   for (int k = 1; k <= 300; ++k) {
     world.step();

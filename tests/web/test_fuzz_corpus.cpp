@@ -12,16 +12,16 @@ namespace vrd {
 namespace {
 
 // A JSON object as the server writes it, which throws for a string that is not valid UTF-8.
-std::string json(const std::string& key, const std::string& value) { return nlohmann::json{{key, value}}.dump(); }
+std::string jsonObject(const std::string& key, const std::string& value) { return nlohmann::json{{key, value}}.dump(); }
 
 TEST(FuzzCorpus, VrClientMessages) {
   testing::checkCorpus("vr_ws", [](std::string_view text) {
     try {
       const vr::ClientMessage m = vr::parseClientMessage(text);
       EXPECT_LE(m.client.size(), 64u);
-      EXPECT_NO_THROW(json("client", m.client));  // cut between characters
+      EXPECT_NO_THROW(jsonObject("client", m.client));  // cut between characters
     } catch (const Error& e) {
-      EXPECT_NO_THROW(json("reason", e.what()));  // the error reply
+      EXPECT_NO_THROW(jsonObject("reason", e.what()));  // the error reply
       throw;
     }
   });
