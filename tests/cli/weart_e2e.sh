@@ -2,7 +2,7 @@
 # End to end with a (fake) glove: the fake middleware closes the hand over 1 s; `vrdeform ARGS...
 # --weart` (touch or run on the liver) must press it, send a force to a thimble of FINGERS (a
 # regular expression such as INDEX; `-` for none: `serve` has no viewer moving the hand), and
-# leave every thimble stopped when it ends.
+# leave every thimble stopped when it ends. E2E_SECONDS (default 2.5): how long the command runs.
 # Usage: weart_e2e.sh VRDEFORM FAKE_WEART SCRATCH_DIR FINGERS ARGS...
 set -eu
 vrdeform=$1 fake=$2 dir=$3 fingers=$4
@@ -15,7 +15,7 @@ trap 'kill $pid 2>/dev/null || true' EXIT
 for _ in $(seq 50); do grep -q '^listening on' "$dir/fake.out" 2>/dev/null && break; sleep 0.1; done
 port=$(sed -n 's/^listening on 127\.0\.0\.1:\([0-9]*\).*/\1/p' "$dir/fake.out")
 [ -n "$port" ] || { echo "the fake middleware did not start"; cat "$dir/fake.out"; exit 1; }
-"$vrdeform" "$@" --weart "127.0.0.1:$port" --seconds 2.5
+"$vrdeform" "$@" --weart "127.0.0.1:$port" --seconds "${E2E_SECONDS:-2.5}"
 kill -TERM $pid && wait $pid || true  # the fake flushes its log as it exits
 trap - EXIT
 echo "--- fake middleware log:"; cat "$dir/fake.log"
