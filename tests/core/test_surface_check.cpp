@@ -124,7 +124,7 @@ TriMesh readObj(const std::filesystem::path& path) {
 
 std::vector<std::filesystem::path> sharedMeshes() {
   std::vector<std::filesystem::path> paths;
-  const std::filesystem::path dir = std::filesystem::path(VRDEFORM_SHARED_DIR) / "data" / "meshes";
+  const std::filesystem::path& dir = testing::kMeshes;
   if (!std::filesystem::is_directory(dir)) return paths;
   for (const auto& entry : std::filesystem::directory_iterator(dir))
     if (entry.path().extension() == ".obj") paths.push_back(entry.path());

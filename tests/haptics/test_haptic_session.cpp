@@ -31,7 +31,7 @@ struct Liver {
   Vec3 top;  // highest surface point after settling
 
   Liver() : world(settings()) {
-    TriMesh surface = readSurface(std::filesystem::path(VRDEFORM_SHARED_DIR) / "data" / "meshes" / "liver_coarse.obj");
+    TriMesh surface = readSurface(testing::kMeshes / "liver_coarse.obj");
     float lowest = 1e9f;
     for (Vec3& v : surface.vertices) v *= 0.001f, lowest = std::min(lowest, v.y());
     for (Vec3& v : surface.vertices) v.y() -= lowest;

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "test_support.h"
 #include "vrdeform/io/surface_io.h"
 #include "vrdeform/mesh/primitives.h"
 #include "vrdeform/sim/body_model.h"
@@ -67,7 +68,7 @@ TEST(Cloth, FlagBillowsInTheWindFromItsPole) {
 
 TEST(Cloth, AnyOpenSurfaceBecomesCloth) {
   // The shared flag: an irregular 1.25 m square in the y = 0 plane, 2,440 edges, 80 on the border.
-  const TriMesh flag = readSurface(std::filesystem::path(VRDEFORM_SHARED_DIR) / "data" / "meshes" / "flag_plane.obj");
+  const TriMesh flag = readSurface(testing::kMeshes / "flag_plane.obj");
   const auto model = makeCloth(flag, clothMaterial());
   EXPECT_EQ(model->distance.size(), 2440u);
   EXPECT_EQ(model->bend.size(), 2440u - 80u);

@@ -31,7 +31,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::TempDir;
-const fs::path kTetMeshes = fs::path(VRDEFORM_SHARED_DIR) / "data" / "meshes" / "tet";
+const fs::path kTetMeshes = testing::kMeshes / "tet";
 
 using testing::readBytes;
 using testing::writeBytes;
