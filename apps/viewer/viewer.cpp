@@ -503,6 +503,9 @@ int Viewer::run() {
 }  // namespace
 
 int runViewer(const ViewerOptions& options) {
+  // First of all: a Ctrl-C while the window opens stops too (a script's background job ignores
+  // SIGINT until a handler is installed).
+  const StopSignals signals;
   glfwSetErrorCallback([](int code, const char* text) { fmt::print(stderr, "glfw: {} (0x{:x})\n", text, code); });
   if (!glfwInit()) {
     fmt::print(stderr, "vrdeform: cannot open a window (no display?); `vrdeform render` draws headless\n");
@@ -530,7 +533,6 @@ int runViewer(const ViewerOptions& options) {
   ImGui_ImplOpenGL3_Init("#version 330");
   int status = 1;
   try {
-    const StopSignals signals;
     Viewer viewer(window, options, signals);
     status = viewer.run();
   } catch (...) {
