@@ -41,9 +41,9 @@ namespace {
 using testing::record;
 
 using testing::kG;
-constexpr float kSize = 0.1f, kE = 1e4f, kRho = 1000.0f;
+constexpr float kCubeSize = 0.1f, kCubeE = 1e4f, kCubeRho = 1000.0f;
 
-struct Hanging {
+struct HangingCube {
   std::vector<Vec3> x;  // settled positions
   double maxDisplacement = 0;
   double support = 0;  // sum of the attachments' vertical forces (N)
@@ -51,13 +51,13 @@ struct Hanging {
   double maxSpeed = 0;
 };
 
-Hanging settle(int iterations) {
+HangingCube settle(int iterations) {
   Material material;
-  material.elastic = ElasticModuli{kE, 0.3f, kRho};
+  material.elastic = ElasticModuli{kCubeE, 0.3f, kCubeRho};
   material.shapeMatching = {1e-2f, 0.0f};
-  const auto model =
-      makeSoftBody(makeBoxTets(Vec3(-0.5f * kSize, -kSize, -0.5f * kSize), Vec3::Constant(kSize), 3, 3, 3), material,
-                   ConstraintSet::paper());
+  const auto model = makeSoftBody(
+      makeBoxTets(Vec3(-0.5f * kCubeSize, -kCubeSize, -0.5f * kCubeSize), Vec3::Constant(kCubeSize), 3, 3, 3), material,
+      ConstraintSet::paper());
   SolverSettings settings;
   settings.timeStep = 1.0f / 60.0f;
   settings.substeps = 20;
@@ -67,7 +67,7 @@ Hanging settle(int iterations) {
   World world(settings);
   const BodyId body = world.addBody(model);  // top face at y = 0, the body below, near the origin
 
-  Hanging out;
+  HangingCube out;
   std::vector<AttachmentId> holds;
   for (Index i = 0; i < model->particleCount(); ++i) {
     out.weight += double(kG) / model->invMass[i];
@@ -87,15 +87,15 @@ Hanging settle(int iterations) {
   return out;
 }
 
-double maxDifference(const Hanging& a, const Hanging& b) {
+double maxDifference(const HangingCube& a, const HangingCube& b) {
   double d = 0;
   for (std::size_t i = 0; i < a.x.size(); ++i) d = std::max(d, double((a.x[i] - b.x[i]).norm()));
   return d;
 }
 
 TEST(StaticShape, SameShapeFor5_20And80Iterations) {
-  const Hanging reference = settle(80);
-  const double sag = double(kRho) * kG * kSize * kSize / (2.0 * kE);  // 4.9 mm
+  const HangingCube reference = settle(80);
+  const double sag = double(kCubeRho) * kG * kCubeSize * kCubeSize / (2.0 * kCubeE);  // 4.9 mm
   record("max_displacement_over_bar_sag", reference.maxDisplacement / sag);
   EXPECT_NEAR(reference.maxDisplacement, sag, 0.2 * sag);
   // Settled: residual speeds far below the sag rate (sag / 0.1 s = 0.05 m/s).
@@ -103,7 +103,7 @@ TEST(StaticShape, SameShapeFor5_20And80Iterations) {
 
   for (int iterations : {5, 20, 80}) {
     SCOPED_TRACE(iterations);
-    const Hanging h = iterations == 80 ? reference : settle(iterations);
+    const HangingCube h = iterations == 80 ? reference : settle(iterations);
     record("it" + std::to_string(iterations) + "_support_over_weight", h.support / h.weight);
     record("it" + std::to_string(iterations) + "_shape_difference_over_displacement",
            maxDifference(h, reference) / reference.maxDisplacement);
