@@ -16,11 +16,6 @@
 #include "vrdeform/error.h"
 
 namespace vrd::io {
-namespace {
-
-bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
-
-}  // namespace
 
 std::string readFileBytes(const std::filesystem::path& path) {
   std::error_code error;

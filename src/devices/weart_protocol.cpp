@@ -25,13 +25,13 @@ constexpr std::string_view kPointNames[] = {"THUMB", "INDEX", "MIDDLE", "ANNULAR
 constexpr const char* kPointKeys[] = {"thumb", "index", "middle", "annular", "pinky", "palm"};  // JSON payload keys
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+bool isFrameSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
 bool isDigit(char c) { return c >= '0' && c <= '9'; }
 bool isIdChar(char c) { return isDigit(c) || (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || c == '_'; }
 
 std::string_view trim(std::string_view s) {
-  while (!s.empty() && isSpace(s.front())) s.remove_prefix(1);
-  while (!s.empty() && isSpace(s.back())) s.remove_suffix(1);
+  while (!s.empty() && isFrameSpace(s.front())) s.remove_prefix(1);
+  while (!s.empty() && isFrameSpace(s.back())) s.remove_suffix(1);
   return s;
 }
 
@@ -165,7 +165,7 @@ Prepared prepare(std::string_view frame) {
       p.error = "'~' inside a frame at byte " + std::to_string(i);
       return p;
     }
-    if ((c < 0x20 && !isSpace(static_cast<char>(c))) || c == 0x7f) {
+    if ((c < 0x20 && !isFrameSpace(static_cast<char>(c))) || c == 0x7f) {
       p.error = "control byte " + hexByte(c) + " at byte " + std::to_string(i);
       return p;
     }

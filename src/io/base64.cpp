@@ -5,6 +5,8 @@
 #include <array>
 #include <limits>
 
+#include "vrdeform/core/text_tokens.h"
+
 namespace vrd::io {
 namespace {
 
@@ -17,8 +19,6 @@ constexpr std::array<signed char, 256> makeValues() {
   return values;
 }
 constexpr std::array<signed char, 256> kValues = makeValues();
-
-bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
 
 }  // namespace
 

@@ -58,7 +58,7 @@ class NodeTags {
   std::unordered_map<std::int64_t, Index> map_;
 };
 
-struct Reader {
+struct GmshReader {
   TextTokens& in;
   std::vector<std::int64_t> tags;
   NodeTags nodeTags;
@@ -229,7 +229,7 @@ TetMesh readGmsh(std::string_view text, const std::string& name, std::vector<Tri
   if (in.integer("the file type (0: ASCII)", 0, 1) == 1) in.fail("binary Gmsh files are not supported (save as ASCII)");
   in.integer("the data size");
 
-  Reader reader{in, {}, {}, {}, faces};
+  GmshReader reader{in, {}, {}, {}, faces};
   reader.expect("$EndMeshFormat");
   while (!in.atEnd()) {
     const std::string_view section = in.next("a section");

@@ -26,7 +26,7 @@ std::string upper(std::string_view s) {
   return u;
 }
 
-struct Reader {
+struct LegacyVtkReader {
   TextTokens& in;
   bool binary = false;
 
@@ -111,7 +111,7 @@ TetMesh readVtkLegacy(std::string_view text, const std::string& name, std::vecto
   if (!parseReal(number, version)) in.fail(fmt::format("unreadable version '{}'", printable(number)));
   in.restOfLine();  // the title
 
-  Reader reader{in};
+  LegacyVtkReader reader{in};
   const std::string mode = upper(in.next("ASCII or BINARY"));
   if (mode != "ASCII" && mode != "BINARY") in.fail(fmt::format("expected ASCII or BINARY, found '{}'", mode));
   reader.binary = mode == "BINARY";

@@ -18,6 +18,9 @@ std::string readFileBytes(const std::filesystem::path& path);
 /// what a broken file holds may be binary garbage.
 std::string printable(std::string_view text);
 
+/// Whitespace as the C locale's isspace has it (space, \t, \n, \r, \v, \f), without its locale.
+constexpr bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
+
 /// The words of one line, separated by spaces, tabs, \r, \v or \f, in order (into `words`, cleared first).
 void splitWords(std::string_view line, std::vector<std::string_view>& words);
 
