@@ -29,12 +29,14 @@ int check(const StudyArgs& a) {
       "items\n",
       s.name, s.conditions.size(), s.tasks.size(), s.trials, s.questions.size(), s.dimensions().size(),
       s.comparisons.size(), s.freeTexts.size());
-  const auto force = [](StudyForce f) { return f == StudyForce::Multipliers ? "multipliers (A)" : "baseline (B)"; };
-  if (s.practice)
-    fmt::print("  practice first: scene {}, force {}\n", s.practice->condition.scene,
-               force(s.practice->condition.force));
-  for (const StudyCondition& c : s.conditions)
-    fmt::print("  condition {}: scene {}, force {}\n", c.name, c.scene, force(c.force));
+  const auto describe = [](const StudyCondition& c) {
+    const SolverSettings& solver = c.spec.solver;
+    return fmt::format("scene {} ({} substeps x {} iterations at {:g} Hz), force {}", c.scene, solver.substeps,
+                       solver.iterations, 1.0 / solver.timeStep,
+                       c.force == StudyForce::Multipliers ? "multipliers (A)" : "baseline (B)");
+  };
+  if (s.practice) fmt::print("  practice first: {}\n", describe(s.practice->condition));
+  for (const StudyCondition& c : s.conditions) fmt::print("  condition {}: {}\n", c.name, describe(c));
   const std::size_t n = a.participants > 0 ? a.participants : 2 * s.conditions.size();
   for (std::size_t k = 1; k <= n; ++k) {
     std::vector<std::string_view> order;

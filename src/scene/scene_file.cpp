@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <numbers>
 
+#include "scene/scene_settings_tables.h"
 #include "scene/toml_schema.h"
 
 namespace vrd {
@@ -27,35 +28,6 @@ Mat3 rotationFromDegrees(const Vec3& degrees) {
   return (Eigen::AngleAxisf(r.z(), Vec3::UnitZ()) * Eigen::AngleAxisf(r.y(), Vec3::UnitY()) *
           Eigen::AngleAxisf(r.x(), Vec3::UnitX()))
       .toRotationMatrix();
-}
-
-SolverSettings readSolver(const Table& t) {
-  t.allowOnly({"rate", "dt", "substeps", "iterations", "gravity", "linear_damping", "simd", "threads",
-               "fuse_strain_volume", "measure_residuals", "tolerance", "warm_start"});
-  t.exclusive("rate", "dt");
-  SolverSettings s;
-  s.substeps = kSceneSubsteps;
-  if (std::optional<Field> f = t.get("rate")) s.timeStep = 1.0 / double(f->integer(1, 100000));
-  t.readNumber("dt", s.timeStep, kPositive);
-  t.readInt("substeps", s.substeps, 1, 1000);
-  t.readInt("iterations", s.iterations, 1, 1000);
-  t.readVec3("gravity", s.gravity);
-  t.readNumber("linear_damping", s.linearDamping, kNonNegative);
-  bool simd = true;
-  t.readBool("simd", simd);
-  s.simd = simd ? SimdLevel::Best : SimdLevel::Off;
-  if (std::optional<Field> f = t.get("threads")) {
-    if (f->isString() && f->string() != "auto")
-      f->fail(fmt::format("expected an integer or \"auto\", got '{}'", printable(f->string())));
-    s.threads = f->isString() ? SolverSettings::kAutoThreads : int(f->integer(1, 256));
-  }
-  t.readBool("fuse_strain_volume", s.fuseStrainVolume);
-  s.measureResiduals = true;  // the scene default: runs and the viewer show how converged each step is
-  t.readBool("measure_residuals", s.measureResiduals);
-  t.readNumber("tolerance", s.tolerance, kNonNegative);
-  t.readBool("warm_start", s.warmStart);
-  validateAt(t, "solver", [&] { validateSolverSettings(s); });
-  return s;
 }
 
 void readModuli(const Table& t, BodyKind kind, Material& m) {
@@ -334,39 +306,6 @@ HandSpec readHand(const Table& t, const std::vector<BodySpec>& bodies) {
   return hand;
 }
 
-HapticsSpec readHaptics(const Table& t) {
-  t.allowOnly({"calibrate", "alpha", "beta_contact", "beta_volume", "beta_strain", "epsilon", "tau_contact",
-               "tau_finger_contact", "tau_volume", "tau_strain", "max_change_per_ms", "baseline_contact_force",
-               "baseline_stiffness"});
-  HapticsSpec h;
-  HapticSignalSettings& s = h.settings.signal;
-  t.readBool("calibrate", h.calibrate);
-  t.readNumber("alpha", s.alphaT, Range{0, 1, true, false});
-  t.readNumber("beta_contact", s.betaContact, kUnit);
-  // beta_v + beta_s = 1 (eq. 42), so one of them gives the other.
-  t.readNumber("beta_volume", s.betaVolume, kUnit);
-  t.readNumber("beta_strain", s.betaStrain, kUnit);
-  if (t.has("beta_volume") && !t.has("beta_strain")) s.betaStrain = 1.0f - s.betaVolume;
-  if (t.has("beta_strain") && !t.has("beta_volume")) s.betaVolume = 1.0f - s.betaStrain;
-  if (std::abs(s.betaVolume + s.betaStrain - 1.0f) > 1e-4f)
-    t.fail("beta_strain", fmt::format("beta_volume + beta_strain must be 1, got {}", s.betaVolume + s.betaStrain));
-  t.readNumber("epsilon", s.epsilon, kNonNegative);
-  t.readNumber("tau_contact", s.tauContact, kPositive);
-  t.readNumber("tau_finger_contact", s.tauFingerContact, kPositive);
-  t.readNumber("tau_volume", s.tauVolume, kPositive);
-  t.readNumber("tau_strain", s.tauStrain, kPositive);
-  if (std::optional<Field> f = t.get("max_change_per_ms")) {
-    if (f->isString() && f->string() != "inf")
-      f->fail(fmt::format("expected a number or \"inf\", got '{}'", printable(f->string())));
-    const bool unlimited = f->isString() || f->real() == kInf;
-    h.settings.maxChangePerMs = unlimited ? std::numeric_limits<float>::infinity() : f->number<float>(kPositive);
-  }
-  t.readNumber("baseline_contact_force", h.settings.baseline.contactForce, kUnit);
-  t.readNumber("baseline_stiffness", h.settings.baseline.stiffness, kNonNegative);
-  validateAt(t, "haptics", [&] { validateHapticSettings(h.settings); });
-  return h;
-}
-
 OutputSpec readOutput(const Table& t) {
   t.allowOnly({"mesh_every", "plots"});
   OutputSpec out;
@@ -395,7 +334,9 @@ SceneSpec readScene(const Table& root, std::string_view sourceName) {
   root.readNumber("settle", scene.settle, kNonNegative);
   root.readNumber("seconds", scene.seconds, kPositive);
   root.readVec3("wind", scene.wind);
-  scene.solver = readSolver(root.table("solver"));
+  scene.solver.substeps = kSceneSubsteps;
+  scene.solver.measureResiduals = true;  // runs and the viewer show how converged each step is
+  readSolverTable(root.table("solver"), scene.solver);
 
   const std::vector<Table> bodies = root.tables("body");
   if (!root.has("body")) root.fail("body", "missing (a scene needs at least one [[body]])");
@@ -424,12 +365,70 @@ SceneSpec readScene(const Table& root, std::string_view sourceName) {
   root.readBool("ground", ground);
   if (ground && scene.colliders.empty()) scene.colliders.push_back(Collider::plane(Vec3::UnitY()));
   scene.hand = readHand(root.table("hand"), scene.bodies);
-  scene.haptics = readHaptics(root.table("haptics"));
+  readHapticsTable(root.table("haptics"), scene.haptics);
   scene.output = readOutput(root.table("output"));
   return scene;
 }
 
 }  // namespace
+
+void readSolverTable(const Table& t, SolverSettings& s) {
+  t.allowOnly({"rate", "dt", "substeps", "iterations", "gravity", "linear_damping", "simd", "threads",
+               "fuse_strain_volume", "measure_residuals", "tolerance", "warm_start"});
+  t.exclusive("rate", "dt");
+  if (std::optional<Field> f = t.get("rate")) s.timeStep = 1.0 / double(f->integer(1, 100000));
+  t.readNumber("dt", s.timeStep, kPositive);
+  t.readInt("substeps", s.substeps, 1, 1000);
+  t.readInt("iterations", s.iterations, 1, 1000);
+  t.readVec3("gravity", s.gravity);
+  t.readNumber("linear_damping", s.linearDamping, kNonNegative);
+  if (t.has("simd")) {
+    bool simd = true;
+    t.readBool("simd", simd);
+    s.simd = simd ? SimdLevel::Best : SimdLevel::Off;
+  }
+  if (std::optional<Field> f = t.get("threads")) {
+    if (f->isString() && f->string() != "auto")
+      f->fail(fmt::format("expected an integer or \"auto\", got '{}'", printable(f->string())));
+    s.threads = f->isString() ? SolverSettings::kAutoThreads : int(f->integer(1, 256));
+  }
+  t.readBool("fuse_strain_volume", s.fuseStrainVolume);
+  t.readBool("measure_residuals", s.measureResiduals);
+  t.readNumber("tolerance", s.tolerance, kNonNegative);
+  t.readBool("warm_start", s.warmStart);
+  validateAt(t, "solver", [&] { validateSolverSettings(s); });
+}
+
+void readHapticsTable(const Table& t, HapticsSpec& h) {
+  t.allowOnly({"calibrate", "alpha", "beta_contact", "beta_volume", "beta_strain", "epsilon", "tau_contact",
+               "tau_finger_contact", "tau_volume", "tau_strain", "max_change_per_ms", "baseline_contact_force",
+               "baseline_stiffness"});
+  HapticSignalSettings& s = h.settings.signal;
+  t.readBool("calibrate", h.calibrate);
+  t.readNumber("alpha", s.alphaT, Range{0, 1, true, false});
+  t.readNumber("beta_contact", s.betaContact, kUnit);
+  // beta_v + beta_s = 1 (eq. 42), so one of them gives the other.
+  t.readNumber("beta_volume", s.betaVolume, kUnit);
+  t.readNumber("beta_strain", s.betaStrain, kUnit);
+  if (t.has("beta_volume") && !t.has("beta_strain")) s.betaStrain = 1.0f - s.betaVolume;
+  if (t.has("beta_strain") && !t.has("beta_volume")) s.betaVolume = 1.0f - s.betaStrain;
+  if (std::abs(s.betaVolume + s.betaStrain - 1.0f) > 1e-4f)
+    t.fail("beta_strain", fmt::format("beta_volume + beta_strain must be 1, got {}", s.betaVolume + s.betaStrain));
+  t.readNumber("epsilon", s.epsilon, kNonNegative);
+  t.readNumber("tau_contact", s.tauContact, kPositive);
+  t.readNumber("tau_finger_contact", s.tauFingerContact, kPositive);
+  t.readNumber("tau_volume", s.tauVolume, kPositive);
+  t.readNumber("tau_strain", s.tauStrain, kPositive);
+  if (std::optional<Field> f = t.get("max_change_per_ms")) {
+    if (f->isString() && f->string() != "inf")
+      f->fail(fmt::format("expected a number or \"inf\", got '{}'", printable(f->string())));
+    const bool unlimited = f->isString() || f->real() == kInf;
+    h.settings.maxChangePerMs = unlimited ? std::numeric_limits<float>::infinity() : f->number<float>(kPositive);
+  }
+  t.readNumber("baseline_contact_force", h.settings.baseline.contactForce, kUnit);
+  t.readNumber("baseline_stiffness", h.settings.baseline.stiffness, kNonNegative);
+  validateAt(t, "haptics", [&] { validateHapticSettings(h.settings); });
+}
 
 SceneSpec parseScene(std::string_view text, std::string_view sourceName, const fs::path& baseDir) {
   const Context ctx{std::string(sourceName), baseDir};

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "scene/scene_settings_tables.h"
 #include "scene/toml_schema.h"
 #include "vrdeform/metrics/latin_square.h"
 #include "vrdeform/scene/scene_library.h"
@@ -49,6 +50,15 @@ std::string uniqueCsvName(const Table& t, std::string_view key, std::vector<std:
   return name;
 }
 
+// The scene `name` (readSceneName's) as condition `t` runs it: its [solver] and [haptics] keys over
+// the scene's own.
+SceneSpec sceneOfCondition(const Table& t, const std::string& name) {
+  SceneSpec spec = loadSceneByName(name);
+  readSolverTable(t.table("solver"), spec.solver);
+  readHapticsTable(t.table("haptics"), spec.haptics);
+  return spec;
+}
+
 constexpr Option<StudyForce> kForces[] = {{"multipliers", StudyForce::Multipliers}, {"baseline", StudyForce::Baseline}};
 
 StudySpec readStudy(const Table& root) {
@@ -69,11 +79,12 @@ StudySpec readStudy(const Table& root) {
 
   std::vector<std::string> names;
   for (const Table& t : root.tables("condition")) {
-    t.allowOnly({"name", "scene", "force"});
+    t.allowOnly({"name", "scene", "force", "solver", "haptics"});
     StudyCondition c;
     c.name = uniqueCsvName(t, "name", names);
     c.scene = readSceneName(t.require("scene"));
     t.readChoice("force", c.force, kForces);
+    c.spec = sceneOfCondition(t, c.scene);
     s.conditions.push_back(std::move(c));
   }
   if (s.conditions.size() < 2) root.fail("condition", "a within-subject study needs two or more [[condition]]s");
@@ -93,10 +104,16 @@ StudySpec readStudy(const Table& root) {
 
   if (root.has("practice")) {
     const Table t = root.table("practice");
-    t.allowOnly({"scene", "force", "seconds", "instructions"});
+    t.allowOnly({"scene", "force", "seconds", "instructions", "solver", "haptics"});
     StudyPractice p{s.conditions.front(), {}};
     p.condition.name = p.task.name = "practice";
-    if (const std::optional<Field> f = t.get("scene")) p.condition.scene = readSceneName(*f);
+    if (const std::optional<Field> f = t.get("scene")) {
+      p.condition.scene = readSceneName(*f);
+      p.condition.spec = sceneOfCondition(t, p.condition.scene);
+    } else {
+      readSolverTable(t.table("solver"), p.condition.spec.solver);
+      readHapticsTable(t.table("haptics"), p.condition.spec.haptics);
+    }
     t.readChoice("force", p.condition.force, kForces);
     t.readNumber("seconds", p.task.seconds, kNonNegative);
     t.readString("instructions", p.task.instructions);

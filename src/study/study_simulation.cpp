@@ -12,7 +12,6 @@
 #include "vrdeform/core/write_file.h"
 #include "vrdeform/error.h"
 #include "vrdeform/metrics/signal_quality.h"
-#include "vrdeform/scene/scene_library.h"
 #include "vrdeform/scene/scene_run.h"
 
 namespace vrd {
@@ -66,7 +65,7 @@ int clampRound(double v, int lo, int hi) { return std::clamp(int(std::lround(v))
 
 nlohmann::json runTrial(const StudyCondition& c, const StudyTask& task, int trial, const fs::path& dir,
                         const StudyRunSettings& settings) {
-  SceneSpec spec = loadSceneByName(c.scene);
+  SceneSpec spec = c.spec;
   spec.output.meshEvery = 0.0;
   spec.output.plots = false;
   SceneBuildObserver observer;
@@ -100,6 +99,8 @@ nlohmann::json runTrial(const StudyCondition& c, const StudyTask& task, int tria
                    {"task", task.name},
                    {"trial", trial},
                    {"scene", c.scene},
+                   {"substeps", spec.solver.substeps},
+                   {"iterations", spec.solver.iterations},
                    {"steps", summary.steps},
                    {"felt_roughness", f.roughness},
                    {"felt_spearman", f.spearman},

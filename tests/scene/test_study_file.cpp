@@ -7,6 +7,7 @@
 
 #include "vrdeform/error.h"
 #include "vrdeform/metrics/latin_square.h"
+#include "vrdeform/scene/scene_library.h"
 #include "vrdeform/study/study_file.h"
 
 namespace vrd {
@@ -108,7 +109,48 @@ TEST(StudyFile, APracticeTrialComesFirst) {
   EXPECT_EQ(studyError(std::string(kSmall) + "[practice]\nscene = \"jely\"\n").substr(0, 40),
             "s.toml:24: practice.scene: no built-in s");
   EXPECT_EQ(studyError(std::string(kSmall) + "[practice]\ntrials = 2\n"),
-            "s.toml:24: practice.trials: unknown key (expected one of: scene, force, seconds, instructions)");
+            "s.toml:24: practice.trials: unknown key (expected one of: scene, force, seconds, instructions, solver, "
+            "haptics)");
+  // On the first condition's scene, its solver keys over the condition's.
+  const StudySpec tuned = parseStudy(std::string(kSmall) + "[practice.solver]\niterations = 2\n", "s.toml", ".");
+  ASSERT_TRUE(tuned.practice);
+  EXPECT_EQ(tuned.practice->condition.spec.solver.iterations, 2);
+  EXPECT_EQ(tuned.practice->condition.spec.solver.substeps, tuned.conditions[0].spec.solver.substeps);
+}
+
+// A condition's [condition.solver] and [condition.haptics] go over its scene's settings: the keys it
+// gives change, the rest stay the scene's, and a mistake there is named as in a scene file.
+TEST(StudyFile, AConditionSetsItsOwnSolverAndHapticSettings) {
+  const std::string small = kSmall;
+  const auto with = [&](const std::string& table) {
+    std::string text = small;
+    const std::string after = "force = \"baseline\"\n";  // condition B, the lines 7-9
+    text.insert(text.find(after) + after.size(), table);
+    return text;
+  };
+  const StudySpec s =
+      parseStudy(with("[condition.solver]\nsubsteps = 16\n[condition.haptics]\nalpha = 0.5\n"), "s.toml", ".");
+  const SceneSpec liver = loadSceneByName("liver");
+  ASSERT_EQ(s.conditions.size(), 3u);
+  const SceneSpec &a = s.conditions[0].spec, &b = s.conditions[1].spec;
+  EXPECT_EQ(a.name, "liver");
+  EXPECT_EQ(a.solver.substeps, liver.solver.substeps);
+  EXPECT_EQ(a.haptics.settings.signal.alphaT, liver.haptics.settings.signal.alphaT);
+  EXPECT_EQ(b.solver.substeps, 16);
+  EXPECT_NE(liver.solver.substeps, 16);
+  EXPECT_EQ(b.solver.iterations, liver.solver.iterations);
+  EXPECT_EQ(b.solver.timeStep, liver.solver.timeStep);
+  EXPECT_EQ(b.haptics.settings.signal.alphaT, 0.5f);
+  EXPECT_NE(liver.haptics.settings.signal.alphaT, 0.5f);
+  EXPECT_EQ(b.haptics.calibrate, liver.haptics.calibrate);
+  EXPECT_EQ(s.conditions[2].spec.name, "jelly");
+
+  EXPECT_EQ(studyError(with("[condition.solver]\nsubsteps = 0\n")),
+            "s.toml:11: condition[2].solver.substeps: must be in 1..1000, got 0");
+  EXPECT_EQ(studyError(with("[condition.haptics]\nalpah = 0.5\n")),
+            "s.toml:11: condition[2].haptics.alpah: unknown key (did you mean 'alpha'?)");
+  EXPECT_EQ(studyError(with("[condition.output]\nplots = false\n")),
+            "s.toml:10: condition[2].output: unknown key (expected one of: name, scene, force, solver, haptics)");
 }
 
 TEST(StudyFile, MistakesAreNamedWithLineAndKey) {

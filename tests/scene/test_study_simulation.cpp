@@ -11,6 +11,7 @@
 #include "test_support.h"
 #include "vrdeform/error.h"
 #include "vrdeform/metrics/latin_square.h"
+#include "vrdeform/scene/scene_library.h"
 #include "vrdeform/study/study_analysis.h"
 #include "vrdeform/study/study_file.h"
 #include "vrdeform/study/study_simulation.h"
@@ -141,6 +142,28 @@ TEST(StudySimulation, ThePracticeTrialComesFirstAndIsKept) {
   EXPECT_EQ(again.trialsRun, 0u);
   EXPECT_EQ(again.trialsKept, 3u);
   EXPECT_EQ(readStudyAnswers(study, data.path).size(), 1u);
+}
+
+// Each trial runs its condition's scene with the condition's own solver settings, and says so.
+TEST(StudySimulation, EachConditionRunsWithItsOwnSolverSettings) {
+  std::string text = kSimulatedStudy;
+  const std::string afterB = "force = \"baseline\"\n";
+  text.insert(text.find(afterB) + afterB.size(), "[condition.solver]\niterations = 2\n");
+  text.replace(text.find("seconds = 4.5"), 13, "seconds = 0.5");
+  const StudySpec study = parseStudy(text, "solver.toml", ".");
+  RunFolder data("solver");
+  StudyRunSettings s;
+  s.dataDir = data.path;
+  EXPECT_EQ(runSimulatedParticipant(study, s).trialsRun, 2u);
+  const std::vector<std::size_t> order = study.orderOf(1);
+  for (std::size_t pos = 0; pos < 2; ++pos) {
+    const StudyCondition& c = study.conditions[order[pos]];
+    const nlohmann::json trial = nlohmann::json::parse(readBytes(testing::participantFolder(data.path, 1) / "trials" /
+                                                                 (std::to_string(pos + 1) + "-1-1") / "trial.json"));
+    EXPECT_EQ(trial["condition"], c.name);
+    EXPECT_EQ(trial["iterations"], c.name == "B" ? 2 : loadSceneByName("liver").solver.iterations);
+    EXPECT_EQ(trial["substeps"], loadSceneByName("liver").solver.substeps);
+  }
 }
 
 TEST(StudySimulation, AStoppedRunResumesKeepingEveryFinishedTrial) {

@@ -1,13 +1,16 @@
 #pragma once
 // What a study file says (docs/study.md): a within-subject haptics study as the paper ran it.
-// Conditions (a scene and the force the glove gets), tasks done in each, trials, rests, the
-// questionnaire (7-point items in dimensions, direct comparisons of the conditions) and the
-// counterbalancing of the conditions' order. Plain data, checked by the parser (study_file.h).
+// Conditions (a scene, its solver and haptic settings, and the force the glove gets), tasks done
+// in each, trials, rests, the questionnaire (7-point items in dimensions, direct comparisons of the
+// conditions) and the counterbalancing of the conditions' order. Plain data, checked by the parser
+// (study_file.h).
 
 #include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "vrdeform/scene/scene_spec.h"
 
 namespace vrd {
 
@@ -19,6 +22,9 @@ struct StudyCondition {
   std::string name;   ///< unique; the data and the analysis name conditions by it
   std::string scene;  ///< a built-in scene's name or a scene file (absolute once loaded)
   StudyForce force = StudyForce::Multipliers;
+  /// The scene as the condition runs it: loaded, with the condition's own [solver] and [haptics]
+  /// keys over the scene's (the rest as the scene has it).
+  SceneSpec spec;
 };
 
 struct StudyTask {
