@@ -50,13 +50,10 @@ std::string uniqueCsvName(const Table& t, std::string_view key, std::vector<std:
   return name;
 }
 
-// The scene `name` (readSceneName's) as condition `t` runs it: its [solver] and [haptics] keys over
-// the scene's own.
-SceneSpec sceneOfCondition(const Table& t, const std::string& name) {
-  SceneSpec spec = loadSceneByName(name);
+// A condition's (or the practice's) [solver] and [haptics] keys, over its scene's own.
+void readConditionSettings(const Table& t, SceneSpec& spec) {
   readSolverTable(t.table("solver"), spec.solver);
   readHapticsTable(t.table("haptics"), spec.haptics);
-  return spec;
 }
 
 constexpr Option<StudyForce> kForces[] = {{"multipliers", StudyForce::Multipliers}, {"baseline", StudyForce::Baseline}};
@@ -84,7 +81,8 @@ StudySpec readStudy(const Table& root) {
     c.name = uniqueCsvName(t, "name", names);
     c.scene = readSceneName(t.require("scene"));
     t.readChoice("force", c.force, kForces);
-    c.spec = sceneOfCondition(t, c.scene);
+    c.spec = loadSceneByName(c.scene);
+    readConditionSettings(t, c.spec);
     s.conditions.push_back(std::move(c));
   }
   if (s.conditions.size() < 2) root.fail("condition", "a within-subject study needs two or more [[condition]]s");
@@ -109,11 +107,9 @@ StudySpec readStudy(const Table& root) {
     p.condition.name = p.task.name = "practice";
     if (const std::optional<Field> f = t.get("scene")) {
       p.condition.scene = readSceneName(*f);
-      p.condition.spec = sceneOfCondition(t, p.condition.scene);
-    } else {
-      readSolverTable(t.table("solver"), p.condition.spec.solver);
-      readHapticsTable(t.table("haptics"), p.condition.spec.haptics);
+      p.condition.spec = loadSceneByName(p.condition.scene);
     }
+    readConditionSettings(t, p.condition.spec);
     t.readChoice("force", p.condition.force, kForces);
     t.readNumber("seconds", p.task.seconds, kNonNegative);
     t.readString("instructions", p.task.instructions);
