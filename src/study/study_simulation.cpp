@@ -3,16 +3,15 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
-#include <nlohmann/json.hpp>
 #include <random>
 #include <vector>
 
-#include "vrdeform/core/text_tokens.h"
-#include "vrdeform/core/write_file.h"
 #include "vrdeform/error.h"
 #include "vrdeform/metrics/signal_quality.h"
 #include "vrdeform/scene/scene_run.h"
+#include "vrdeform/study/participant_progress.h"
 
 namespace vrd {
 namespace {
@@ -21,11 +20,7 @@ namespace fs = std::filesystem;
 
 // What a trial's index finger felt during the scene's first scripted poke: the glove's signal
 // (the force for condition A, the baseline for B) against the indentation.
-struct Felt {
-  double roughness = 1.0, spearman = 1.0, peak = 0.0;
-};
-
-Felt feltInTrial(const SceneSpec& spec, const std::vector<double>& depth, const std::vector<double>& felt) {
+FeltSignal feltInTrial(const SceneSpec& spec, const std::vector<double>& depth, const std::vector<double>& felt) {
   const double dt = spec.solver.timeStep;
   for (const ActionSpec& a : spec.hand.actions) {
     if (a.action.kind != ActionKind::Poke) continue;
@@ -37,7 +32,7 @@ Felt feltInTrial(const SceneSpec& spec, const std::vector<double>& depth, const 
     const std::size_t holdEnd = holdBegin + std::size_t(std::lround(a.action.hold / dt));
     const SignalQuality q =
         signalQuality(std::span(depth).subspan(begin, n), std::span(felt).subspan(begin, n), holdBegin, holdEnd);
-    Felt f;
+    FeltSignal f;
     f.peak = q.peak;
     if (std::isfinite(q.roughness)) f.roughness = q.roughness;
     f.spearman = std::isfinite(q.loadingSpearman) ? q.loadingSpearman : 0.0;  // no rise with depth: nothing graded
@@ -48,7 +43,7 @@ Felt feltInTrial(const SceneSpec& spec, const std::vector<double>& depth, const 
 
 // The model answer (1..points) for what was felt: a clean, graded signal (roughness 1, loading
 // Spearman 1) rates near the top, a stepped or ungraded one near the middle.
-double feltScore(const Felt& f, int points) {
+double feltScore(const FeltSignal& f, int points) {
   const double q = std::clamp(2.0 - f.roughness, 0.0, 1.0) * std::clamp(f.spearman, 0.0, 1.0);
   return 1.0 + (points - 1) * (0.35 + 0.6 * q);
 }
@@ -63,21 +58,20 @@ double draw(const SimulatedParticipant& s, std::size_t participant, std::size_t 
 
 int clampRound(double v, int lo, int hi) { return std::clamp(int(std::lround(v)), lo, hi); }
 
-nlohmann::json runTrial(const StudyCondition& c, const StudyTask& task, int trial, const fs::path& dir,
-                        const StudyRunSettings& settings) {
+// The scene run with its scripted hand for the task's length into the progress's scratch folder.
+TrialRecord runTrial(ParticipantProgress& progress, const StudyRunSettings& settings) {
+  const StudyStep step = progress.next();
+  const StudyCondition& c = progress.condition(step);
   SceneSpec spec = c.spec;
   spec.output.meshEvery = 0.0;
   spec.output.plots = false;
   SceneBuildObserver observer;
   observer.stop = settings.stop;
   BuiltScene scene = buildScene(spec, observer);
-  const double seconds = task.seconds > 0.0 ? task.seconds : spec.seconds;
+  const double seconds = progress.task(step).seconds > 0.0 ? progress.task(step).seconds : spec.seconds;
   RunSettings run;
   run.steps = std::uint64_t(std::lround(seconds / spec.solver.timeStep));
-  const fs::path partial = dir.parent_path() / (dir.filename().string() + ".partial");
-  std::error_code error;
-  fs::remove_all(partial, error);  // what a killed run left
-  run.outDir = partial;
+  run.outDir = progress.beginTrial();
   std::vector<double> depth, felt;
   bool stopped = false;
   run.afterStep = [&](const RunStep& s) {
@@ -89,132 +83,121 @@ nlohmann::json runTrial(const StudyCondition& c, const StudyTask& task, int tria
     stopped = settings.stop && settings.stop();
     return !stopped;
   };
+  const auto began = std::chrono::steady_clock::now();
   const RunSummary summary = runScene(scene, run);
   if (stopped) {
-    fs::remove_all(partial, error);
-    throw Stopped(fmt::format("stopped during trial {} of {} in condition {}", trial, task.name, c.name));
+    std::error_code error;
+    fs::remove_all(run.outDir, error);
+    throw Stopped(
+        fmt::format("stopped during trial {} of {} in condition {}", step.trial, progress.task(step).name, c.name));
   }
-  const Felt f = feltInTrial(spec, depth, felt);
-  nlohmann::json j{{"condition", c.name},
-                   {"task", task.name},
-                   {"trial", trial},
-                   {"scene", c.scene},
-                   {"substeps", spec.solver.substeps},
-                   {"iterations", spec.solver.iterations},
-                   {"steps", summary.steps},
-                   {"felt_roughness", f.roughness},
-                   {"felt_spearman", f.spearman},
-                   {"felt_peak", f.peak}};
-  writeFile(partial / "trial.json", j.dump(2) + "\n");
-  fs::rename(partial, dir, error);  // the finished trial appears whole
-  if (error)
-    throw Error(fmt::format("{}: cannot move the finished trial into place: {}", dir.string(), error.message()));
-  return j;
+  const TrialRecord record{summary.steps,
+                           std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count(),
+                           feltInTrial(spec, depth, felt)};
+  progress.finishTrial(record);
+  return record;
 }
 
-// A kept trial's record; anything but what runTrial wrote is refused, naming the folder to delete.
-nlohmann::json readTrial(const fs::path& file) {
-  nlohmann::json j = nlohmann::json::parse(io::readFileBytes(file), nullptr, false);
-  if (!j.is_object() || !j.contains("felt_roughness") || !j["felt_roughness"].is_number() ||
-      !j.contains("felt_spearman") || !j["felt_spearman"].is_number())
-    throw Error(
-        fmt::format("{}: not a finished trial's record; delete its folder to run the trial again", file.string()));
-  return j;
+// The answers after a condition from what was felt in its trials: items of the "visual"
+// dimension alike in every condition (the same picture), the others from the felt score; each
+// with the participant's noise. Free text: whether the force grew smoothly or jumped.
+ConditionAnswers answerCondition(const ParticipantProgress& progress, const SimulatedParticipant& simulated,
+                                 double score, const FeltSignal& mean) {
+  const StudySpec& study = progress.study();
+  const std::size_t c = progress.next().condition;
+  ConditionAnswers a;
+  for (std::size_t q = 0; q < study.questions.size(); ++q) {
+    const double model = study.questions[q].dimension == "visual" ? 1.0 + 0.75 * (study.points - 1) : score;
+    a.likert.push_back(clampRound(model + draw(simulated, progress.participant(), c, q), 1, study.points));
+  }
+  for (const StudyFreeText& f : study.freeTexts)
+    if (f.perCondition)
+      a.freeText.push_back(fmt::format("The force {} as I pressed (roughness {:.2f}, loading Spearman {:.3f}).",
+                                       mean.roughness <= 1.1 && mean.spearman >= 0.9 ? "grew smoothly" : "jumped",
+                                       mean.roughness, mean.spearman));
+  return a;
+}
+
+// Each direct comparison: the difference of the two conditions' felt scores; free text: which felt best.
+FinalAnswers answerStudy(const ParticipantProgress& progress, const SimulatedParticipant& simulated,
+                         const std::vector<double>& score) {
+  const StudySpec& study = progress.study();
+  FinalAnswers a;
+  for (std::size_t d = 0; d < study.comparisons.size(); ++d) {
+    const StudyComparison& x = study.comparisons[d];
+    const double model = score[x.b] - score[x.a];  // negative: the first felt better
+    a.comparisons.push_back(
+        clampRound(model + draw(simulated, progress.participant(), study.conditions.size(), study.questions.size() + d),
+                   -study.comparisonRange, study.comparisonRange));
+  }
+  const std::size_t best = std::size_t(std::max_element(score.begin(), score.end()) - score.begin());
+  for (const StudyFreeText& f : study.freeTexts)
+    if (!f.perCondition) a.freeText.push_back(fmt::format("{} felt best.", study.conditions[best].name));
+  return a;
 }
 
 }  // namespace
 
 StudyRunResult runSimulatedParticipant(const StudySpec& study, const StudyRunSettings& settings) {
-  const std::vector<std::size_t> order = study.orderOf(settings.participant);
-  const fs::path me = settings.dataDir / fmt::format("P{}", settings.participant);
-  prepareOutputFolder(me / "trials");
+  ParticipantProgress progress(study, settings.dataDir, settings.participant, true, settings.simulated.seed);
   StudyRunResult result;
-  if (study.practice) {
-    const fs::path dir = me / "practice";
-    if (fs::is_regular_file(dir / "trial.json")) {
-      readTrial(dir / "trial.json");
-      ++result.trialsKept;
-    } else {
-      runTrial(study.practice->condition, study.practice->task, 1, dir, settings);
-      ++result.trialsRun;
-      if (settings.log) settings.log(fmt::format("P{}: practice", settings.participant));
-    }
-  }
-  std::vector<double> score(study.conditions.size(), 0.0), roughness(score), spearman(score);
-  for (std::size_t pos = 0; pos < order.size(); ++pos) {
-    const StudyCondition& c = study.conditions[order[pos]];
-    double sum = 0.0;
+  result.trialsKept = progress.trialsKept();
+  // A condition's mean felt signal and score over its trials (finished now or by an earlier run).
+  const auto felt = [&](std::size_t position) {
+    FeltSignal mean{0.0, 0.0, 0.0};
+    double score = 0.0;
     int count = 0;
     for (std::size_t t = 0; t < study.tasks.size(); ++t)
       for (int r = 1; r <= study.trials; ++r) {
-        if (settings.stop && settings.stop()) throw Stopped("stopped between trials");
-        const fs::path dir = me / "trials" / fmt::format("{}-{}-{}", pos + 1, t + 1, r);
-        nlohmann::json j;
-        if (fs::is_regular_file(dir / "trial.json")) {
-          j = readTrial(dir / "trial.json");
-          ++result.trialsKept;
-        } else {
-          j = runTrial(c, study.tasks[t], r, dir, settings);
-          ++result.trialsRun;
-          if (settings.log)
-            settings.log(
-                fmt::format("P{}: condition {} ({} of {}), {} trial {}: felt roughness {:.2f}, Spearman {:.3f}",
-                            settings.participant, c.name, pos + 1, order.size(), study.tasks[t].name, r,
-                            j["felt_roughness"].get<double>(), j["felt_spearman"].get<double>()));
-        }
-        sum += feltScore({j["felt_roughness"].get<double>(), j["felt_spearman"].get<double>(), 0.0}, study.points);
-        roughness[order[pos]] += j["felt_roughness"].get<double>();
-        spearman[order[pos]] += j["felt_spearman"].get<double>();
+        const TrialRecord rec =
+            progress.trialRecord({StudyStepKind::Trial, position, progress.order()[position], t, r});
+        if (!rec.felt)
+          throw Error(fmt::format("P{}: a trial of a live participant; not simulated", settings.participant));
+        mean.roughness += rec.felt->roughness;
+        mean.spearman += rec.felt->spearman;
+        score += feltScore(*rec.felt, study.points);
         ++count;
       }
-    score[order[pos]] = sum / count;
-    roughness[order[pos]] /= count;
-    spearman[order[pos]] /= count;
-  }
-
-  // The answers: items of the "visual" dimension alike in every condition (the same picture), the
-  // others from what was felt; each with the participant's noise.
-  std::string answers = "condition,item,answer\n";
-  for (std::size_t c = 0; c < study.conditions.size(); ++c)
-    for (std::size_t q = 0; q < study.questions.size(); ++q) {
-      const double model = study.questions[q].dimension == "visual" ? 1.0 + 0.75 * (study.points - 1) : score[c];
-      answers += fmt::format("{},{},{}\n", study.conditions[c].name, study.questions[q].id,
-                             clampRound(model + draw(settings.simulated, settings.participant, c, q), 1, study.points));
+    mean.roughness /= count;
+    mean.spearman /= count;
+    return std::pair(mean, score / count);
+  };
+  for (StudyStep step = progress.next(); step.kind != StudyStepKind::Done; step = progress.next()) {
+    if (settings.stop && settings.stop()) throw Stopped("stopped between trials");
+    switch (step.kind) {
+      case StudyStepKind::Practice:
+        runTrial(progress, settings);
+        ++result.trialsRun;
+        if (settings.log) settings.log(fmt::format("P{}: practice", settings.participant));
+        break;
+      case StudyStepKind::Trial: {
+        const TrialRecord r = runTrial(progress, settings);
+        ++result.trialsRun;
+        if (settings.log)
+          settings.log(fmt::format("P{}: condition {} ({} of {}), {} trial {}: felt roughness {:.2f}, Spearman {:.3f}",
+                                   settings.participant, study.conditions[step.condition].name, step.position + 1,
+                                   study.conditions.size(), study.tasks[step.task].name, step.trial, r.felt->roughness,
+                                   r.felt->spearman));
+        break;
+      }
+      case StudyStepKind::ConditionQuestions: {
+        const auto [mean, score] = felt(step.position);
+        progress.answer(answerCondition(progress, settings.simulated, score, mean));
+        break;
+      }
+      case StudyStepKind::Rest:  // a simulated participant needs none
+        progress.finishRest();
+        break;
+      case StudyStepKind::StudyQuestions: {
+        std::vector<double> score(study.conditions.size(), 0.0);
+        for (std::size_t pos = 0; pos < progress.order().size(); ++pos) score[progress.order()[pos]] = felt(pos).second;
+        progress.answer(answerStudy(progress, settings.simulated, score));
+        break;
+      }
+      case StudyStepKind::Done:
+        break;
     }
-  std::string comparisons = "item,rating\n";
-  for (std::size_t d = 0; d < study.comparisons.size(); ++d) {
-    const StudyComparison& x = study.comparisons[d];
-    const double model = score[x.b] - score[x.a];  // negative: the first felt better
-    comparisons += fmt::format("{},{}\n", x.id,
-                               clampRound(model + draw(settings.simulated, settings.participant,
-                                                       study.conditions.size(), study.questions.size() + d),
-                                          -study.comparisonRange, study.comparisonRange));
   }
-  // Free text: what was felt in each condition, and which felt best.
-  nlohmann::json freeText = nlohmann::json::array();
-  const std::size_t best = std::size_t(std::max_element(score.begin(), score.end()) - score.begin());
-  for (const StudyFreeText& f : study.freeTexts) {
-    if (!f.perCondition) {
-      freeText.push_back({{"item", f.id}, {"text", fmt::format("{} felt best.", study.conditions[best].name)}});
-      continue;
-    }
-    for (std::size_t c : order)
-      freeText.push_back({{"item", f.id},
-                          {"condition", study.conditions[c].name},
-                          {"text", fmt::format("The force {} as I pressed (roughness {:.2f}, loading Spearman {:.3f}).",
-                                               roughness[c] <= 1.1 && spearman[c] >= 0.9 ? "grew smoothly" : "jumped",
-                                               roughness[c], spearman[c])}});
-  }
-  nlohmann::json who{{"participant", fmt::format("P{}", settings.participant)},
-                     {"number", settings.participant},
-                     {"simulated", true},
-                     {"seed", settings.simulated.seed},
-                     {"order", nlohmann::json::array()}};
-  for (std::size_t c : order) who["order"].push_back(study.conditions[c].name);
-  writeFile(me / "answers.csv", answers);
-  writeFile(me / "comparisons.csv", comparisons);
-  writeFile(me / "free_text.json", freeText.dump(2) + "\n");
-  writeFile(me / "participant.json", who.dump(2) + "\n");
   return result;
 }
 

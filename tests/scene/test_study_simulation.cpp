@@ -2,6 +2,7 @@
 // in their Latin-square order, and a run stopped part-way resumes without losing a finished trial.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -180,7 +181,11 @@ TEST(StudySimulation, AStoppedRunResumesKeepingEveryFinishedTrial) {
   ASSERT_TRUE(fs::is_regular_file(first / "trial.json"));
   EXPECT_FALSE(fs::exists(data.path / "P2" / "trials" / "2-1-1"));
   EXPECT_FALSE(anyPartial(data.path));
-  EXPECT_FALSE(fs::exists(data.path / "P2" / "answers.csv"));
+  // The first condition's questionnaire was answered after its trial: its rows alone.
+  const std::string firstAnswers = readBytes(data.path / "P2" / "answers.csv");
+  EXPECT_EQ(std::count(firstAnswers.begin(), firstAnswers.end(), '\n'), 4) << firstAnswers;
+  EXPECT_EQ(firstAnswers.find("\n" + study.conditions[study.orderOf(2)[1]].name + ","), std::string::npos);
+  EXPECT_FALSE(fs::exists(data.path / "P2" / "comparisons.csv"));
   const std::string kept = readBytes(first / "trial.json");
   const fs::file_time_type keptTime = fs::last_write_time(first / "trial.json");
 

@@ -32,13 +32,13 @@ struct StudyRunResult {
   std::size_t trialsKept = 0;  ///< finished by an earlier run and kept as they were
 };
 
-/// Runs participant k through the practice trial (P<k>/practice/, when the study has one), then
-/// every condition (in their order), task and trial, then writes their answers. Each trial's files go into
-/// P<k>/trials/<position>-<task>-<trial>/ (the run's per-step forces.csv, summary.json and trial.json with what was
-/// felt), written into a scratch folder and renamed into place when complete, so a run stopped or killed part-way loses
-/// no finished trial and a second run of the same participant picks up where it ended. participant.json, answers.csv,
-/// comparisons.csv and free_text.json (docs/study.md) are written last, each complete or not at all. Throws
-/// vrd::Error for a scene that cannot be built or run, vrd::Stopped when `stop` says so.
+/// Runs participant k through their steps (study/participant_progress.h: the practice trial, every
+/// condition's trials in their order, each followed by its questionnaire, the final questions),
+/// answering from what was felt. Each trial's files (the run's per-step forces.csv, summary.json and
+/// trial.json with what was felt) go into P<k>/trials/<position>-<task>-<trial>/; a run stopped or
+/// killed part-way loses no finished trial or questionnaire, and a second run of the same participant
+/// picks up where it ended. Throws vrd::Error for a scene that cannot be built or run, vrd::Stopped
+/// when `stop` says so.
 StudyRunResult runSimulatedParticipant(const StudySpec& study, const StudyRunSettings& settings);
 
 }  // namespace vrd
