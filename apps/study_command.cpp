@@ -7,8 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "viewer/viewer.h"
+#include "vrdeform/devices/glove_link.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
+#include "vrdeform/study/participant_progress.h"
 #include "vrdeform/study/study_analysis.h"
 #include "vrdeform/study/study_file.h"
 #include "vrdeform/study/study_simulation.h"
@@ -17,9 +20,10 @@ namespace vrd {
 namespace {
 
 struct StudyArgs {
-  std::string study, data, out;
+  std::string study, data, out, weart;
   std::size_t participants = 0, participant = 0;
   std::uint64_t seed = 1;
+  bool autopilot = false;
 };
 
 int check(const StudyArgs& a) {
@@ -90,6 +94,37 @@ int simulate(const StudyArgs& a) {
   return 0;
 }
 
+// A live participant in the desktop viewer, resumed where an earlier run ended.
+int runLive(const StudyArgs& a) {
+  const StudySpec s = loadStudy(a.study);
+  ParticipantProgress progress(s, a.data, a.participant, false);
+  std::vector<std::string_view> order;
+  for (std::size_t c : progress.order()) order.push_back(s.conditions[c].name);
+  fmt::print("P{}: {} ({} trials kept from an earlier run)\n", a.participant, fmt::join(order, ", "),
+             progress.trialsKept());
+  if (progress.next().kind != StudyStepKind::Done) {
+    ViewerOptions o;
+    o.study = &progress;
+    o.autopilot = a.autopilot;
+    o.weart = a.weart;
+    try {
+      if (const int status = runViewer(o); status != 0) return status;
+    } catch (const Stopped& e) {  // Ctrl-C while a scene was built
+      fmt::print(stderr, "vrdeform: {}\n", e.what());
+    }
+  }
+  if (progress.next().kind != StudyStepKind::Done) {
+    fmt::print(stderr,
+               "vrdeform: P{} stopped before the end; their finished trials and answers are kept: run the same "
+               "command again to go on\n",
+               a.participant);
+    return 130;
+  }
+  fmt::print("P{}: done, in {}; next: vrdeform study analyse {} {}\n", a.participant, progress.folder().string(),
+             a.study, a.data);
+  return 0;
+}
+
 }  // namespace
 
 std::function<int()> addStudyCommand(CLI::App& app) {
@@ -113,7 +148,23 @@ std::function<int()> addStudyCommand(CLI::App& app) {
       ->check(CLI::Range(1, 10000));
   simulateCmd->add_option("--participant", a->participant, "Participant K alone")->check(CLI::Range(1, 10000));
   simulateCmd->add_option("--seed", a->seed, "Seed of the simulated answers' noise")->capture_default_str();
-  return [a, checkCmd, analyseCmd, simulateCmd]() -> int {
+  CLI::App* runCmd = cmd->add_subcommand(
+      "run", "Walk a participant through the study in the desktop viewer, into DATA/P<K> (resumable)");
+  runCmd->add_option("study", a->study, "The study file (.toml)")->required();
+  runCmd->add_option("data", a->data, "The study's data folder")->required();
+  runCmd->add_option("--participant", a->participant, "Participant K: their order of the conditions follows from K")
+      ->check(CLI::Range(1, 10000))
+      ->required();
+  runCmd
+      ->add_option("--weart", a->weart,
+                   "The participant's WEART glove: HOST[:PORT] of the middleware (default port 13031); without "
+                   "it the mouse is the hand")
+      ->check(CLI::Validator(weartEndpointError, "HOST[:PORT]"));
+  runCmd->add_flag("--autopilot", a->autopilot,
+                   "A dry run of the set-up: every step starts by itself, the scenes' scripted hands poke, the "
+                   "questions get the scales' middles and rests are skipped");
+  return [a, checkCmd, analyseCmd, simulateCmd, runCmd]() -> int {
+    if (*runCmd) return runLive(*a);
     if (*checkCmd) return check(*a);
     if (*simulateCmd) return simulate(*a);
     if (*analyseCmd) return analyse(*a);

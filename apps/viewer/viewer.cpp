@@ -1,6 +1,7 @@
 #include "viewer.h"
 
 #include "../build_observer.h"
+#include "questionnaire.h"
 
 #include <epoxy/gl.h>
 // GLFW after epoxy, which must come before any other OpenGL header.
@@ -13,10 +14,13 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <vector>
 
+#include "vrdeform/devices/csv_recorder.h"
 #include "vrdeform/devices/glove_link.h"
 #include "vrdeform/devices/haptic_output.h"
 #include "vrdeform/devices/stop_signals.h"
@@ -28,6 +32,7 @@
 #include "vrdeform/render/scene_renderer.h"
 #include "vrdeform/scene/scene_library.h"
 #include "vrdeform/scene/simulation_loop.h"
+#include "vrdeform/study/participant_progress.h"
 
 namespace vrd {
 namespace {
@@ -40,6 +45,8 @@ struct Running {
   BuiltScene scene;
   LiveHandInput mouseInput;
   std::optional<GloveLink> glove;
+  std::optional<BaselineAsForce> baselineGlove;  // a study's condition B: the glove gets the baseline
+  std::optional<CsvRecorder> recorder;           // a study's trial: its signal, forces.csv
   std::unique_ptr<SimulationLoop> loop;
   std::shared_ptr<SnapshotChannel> channel;
   Snapshot settled;  // the world before the first step: drawn until the first snapshot arrives
@@ -61,23 +68,36 @@ struct Running {
   }
 };
 
-std::unique_ptr<Running> start(const SceneSpec& spec, const SceneBuildObserver& observer, const std::string& weart) {
+// How a built scene's loop runs: the viewer's defaults, or a study's trial.
+struct LoopOptions {
+  std::string weart;             // HOST[:PORT] of the WEART middleware; empty: the mouse is the hand
+  bool paused = false;           // the loop starts paused
+  bool scripted = false;         // the scene's scripted hand drives it (a study's dry run)
+  bool baseline = false;         // the glove gets the condition B baseline
+  std::uint64_t maxSteps = 0;    // 0: until stopped
+  std::filesystem::path forces;  // the signal recorded here (CSV); empty: nowhere
+};
+
+std::unique_ptr<Running> start(const SceneSpec& spec, const SceneBuildObserver& observer, const LoopOptions& o) {
   auto r = std::make_unique<Running>(spec, observer);
   r->mouseInput.set(r->mouse.update({}, r->posed, OrbitCamera{}, 0.0f));  // parked
   SimulationLoopSettings settings;
-  if (!weart.empty() && spec.hand.enabled) {
+  settings.maxSteps = o.maxSteps;
+  settings.input = &r->mouseInput;
+  if (!o.weart.empty() && spec.hand.enabled) {
     const Vec3 point = r->scene.actions.empty() ? r->scene.bodies.front().top : r->scene.actions.front().target;
-    r->glove.emplace(weart, r->scene.session.hand, point);
+    r->glove.emplace(o.weart, r->scene.session.hand, point);
     settings.input = &r->glove->input();
-    settings.outputs.push_back(&r->glove->output());
-  } else {
-    settings.input = &r->mouseInput;
+    settings.outputs.push_back(o.baseline ? &r->baselineGlove.emplace(r->glove->output()) : &r->glove->output());
   }
+  if (o.scripted) settings.input = nullptr;
+  if (!o.forces.empty()) settings.outputs.push_back(&r->recorder.emplace(o.forces, r->scene.session.hand.fingers));
   captureSnapshot(r->settled, *r->scene.world, nullptr, 0, 0.0);
   captureConstraintForces(r->settled, *r->scene.world);
   r->posed.pose(r->settled, ColorMap::None);
   r->loop = std::make_unique<SimulationLoop>(r->scene, settings);
   r->channel = r->loop->subscribe();
+  r->loop->setPaused(o.paused);
   r->loop->start();
   return r;
 }
@@ -105,9 +125,14 @@ class Viewer {
   Viewer(GLFWwindow* window, const ViewerOptions& options, const StopSignals& signals)
       : window_(window), options_(options), signals_(signals), observer_(commandObserver(signals)) {
     render_.colorMap = options.colorMap;
-    spec_ = loadSceneByName(options.scene);
-    sceneName_ = spec_.name;
-    rebuild();
+    loop_.weart = options.weart;
+    if (options.study) {
+      prepareStudyStep(true);
+    } else {
+      spec_ = loadSceneByName(options.scene);
+      sceneName_ = spec_.name;
+      rebuild();
+    }
     render_.colorRange = defaultColorRange(options.colorMap, running_->settled);
   }
 
@@ -127,12 +152,22 @@ class Viewer {
   void timingPanel();
   void convergencePanel();
   void screenshot(int width, int height) const;
+  // A study's participant (options_.study): one panel for the step at hand.
+  void prepareStudyStep(bool first);
+  void studyPanel();
+  void trialPanel(const StudyStep& step);
+  void startTrial();
+  void finishTrial();
+  void restPanel();
+  void questionsPanel(const StudyStep& step);
+  bool studyDone() const { return options_.study && options_.study->next().kind == StudyStepKind::Done; }
 
   GLFWwindow* window_;
   ViewerOptions options_;
   const StopSignals& signals_;
   SceneBuildObserver observer_;     // prints the build's progress on the terminal; Ctrl-C stops it
   SceneSpec spec_;                  // what the next rebuild builds (the sliders edit it)
+  LoopOptions loop_;                // how its loop runs
   std::optional<SceneSpec> built_;  // what the running scene was built from
   std::string sceneName_;
   std::unique_ptr<Running> running_;
@@ -148,6 +183,9 @@ class Viewer {
   int snapshotIterations_ = 0;
   double stepWallMs_ = 0.0, frameMs_ = 0.0;
   std::uint64_t lastStep_ = 0;
+  bool trialStarted_ = false;
+  Clock::time_point trialBegan_, restBegan_;
+  std::optional<Questionnaire> questionnaire_;
 };
 
 void Viewer::rebuild() {
@@ -156,13 +194,13 @@ void Viewer::rebuild() {
   stopped_ = false;
   glfwSetWindowTitle(window_, fmt::format("vrdeform view: {} (building...)", spec_.name).c_str());
   try {
-    running_ = start(spec_, observer_, options_.weart);
+    running_ = start(spec_, observer_, loop_);
     built_ = spec_;
   } catch (const Error& e) {  // e.g. a material the builder refuses: back to the last scene that built
     fmt::print(stderr, "vrdeform: cannot rebuild {}: {}\n", spec_.name, e.what());
     if (!built_) throw;
     spec_ = *built_;
-    running_ = start(spec_, observer_, options_.weart);
+    running_ = start(spec_, observer_, loop_);
     error_ = fmt::format("rebuild refused: {}", e.what());
   }
   glfwSetWindowTitle(window_, fmt::format("vrdeform view: {}", spec_.name).c_str());
@@ -218,7 +256,14 @@ void Viewer::handleInput(float dt) {
     if (glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS) camera_.pan(dx / float(h), dy / float(h));
     if (io.MouseWheel != 0.0f) camera_.zoom(std::pow(0.9f, io.MouseWheel));
   }
-  if (!uiKeys) {
+  if (!uiKeys && options_.study) {
+    if (ImGui::IsKeyPressed(GLFW_KEY_SPACE) && !trialStarted_) {
+      const StudyStepKind k = options_.study->next().kind;
+      if (k == StudyStepKind::Practice || k == StudyStepKind::Trial) startTrial();
+    }
+    if (ImGui::IsKeyPressed(GLFW_KEY_R)) camera_.frame(running_->posed.bounds());
+    if (ImGui::IsKeyPressed(GLFW_KEY_ESCAPE)) glfwSetWindowShouldClose(window_, GLFW_TRUE);
+  } else if (!uiKeys) {
     if (ImGui::IsKeyPressed(GLFW_KEY_SPACE)) {
       paused_ = !paused_;
       running_->loop->setPaused(paused_);
@@ -436,6 +481,137 @@ void Viewer::panels() {
   ImGui::End();
 }
 
+// The scene the participant's next step shows. A trial's is built afresh and paused, its signal
+// recorded into the trial's scratch folder, until the participant starts it; after the last trial
+// of a condition its scene stays in view through the questions and the rest.
+void Viewer::prepareStudyStep(bool first) {
+  ParticipantProgress& p = *options_.study;
+  const StudyStep s = p.next();
+  questionnaire_.reset();
+  trialStarted_ = false;
+  restBegan_ = Clock::now();
+  const bool trial = s.kind == StudyStepKind::Practice || s.kind == StudyStepKind::Trial;
+  if (!trial && !first) return;
+  loop_ = LoopOptions();
+  loop_.weart = options_.weart;
+  loop_.paused = true;
+  if (trial) {
+    const StudyCondition& c = p.condition(s);
+    const double seconds = p.task(s).seconds > 0.0 ? p.task(s).seconds : c.spec.seconds;
+    spec_ = c.spec;
+    loop_.maxSteps = std::uint64_t(std::max(std::lround(seconds / spec_.solver.timeStep), 1L));
+    loop_.forces = p.beginTrial() / "forces.csv";
+    loop_.baseline = c.force == StudyForce::Baseline;
+    loop_.scripted = options_.autopilot;
+  } else {
+    spec_ = p.study().conditions[s.kind == StudyStepKind::ConditionQuestions ? s.condition : p.order().front()].spec;
+  }
+  paused_ = true;
+  rebuild();
+  glfwSetWindowTitle(window_, fmt::format("vrdeform study: {}, P{}", p.study().name, p.participant()).c_str());
+}
+
+void Viewer::studyPanel() {
+  const ParticipantProgress& p = *options_.study;
+  const StudyStep s = p.next();
+  ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(560, 0), ImGuiCond_FirstUseEver);
+  ImGui::Begin("Study");
+  ImGui::TextDisabled("%s, P%zu", p.study().name.c_str(), p.participant());
+  switch (s.kind) {
+    case StudyStepKind::Practice:
+    case StudyStepKind::Trial:
+      trialPanel(s);
+      break;
+    case StudyStepKind::ConditionQuestions:
+    case StudyStepKind::StudyQuestions:
+      questionsPanel(s);
+      break;
+    case StudyStepKind::Rest:
+      restPanel();
+      break;
+    case StudyStepKind::Done:
+      ImGui::TextWrapped("All done: thank you! (Esc closes the window.)");
+      break;
+  }
+  if (!error_.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", error_.c_str());
+  ImGui::End();
+}
+
+void Viewer::trialPanel(const StudyStep& s) {
+  const ParticipantProgress& p = *options_.study;
+  const StudyTask& task = p.task(s);
+  const std::string title = s.kind == StudyStepKind::Practice
+                                ? std::string("Practice")
+                                : fmt::format("Part {} of {}: {}, trial {} of {}", s.position + 1, p.order().size(),
+                                              task.name, s.trial, p.study().trials);
+  ImGui::TextUnformatted(title.c_str());
+  if (!task.instructions.empty()) ImGui::TextWrapped("%s", task.instructions.c_str());
+  if (failed_) {  // the simulation failed: this trial is not kept
+    if (ImGui::Button("Run the trial again")) prepareStudyStep(false);
+    return;
+  }
+  if (!trialStarted_) {
+    if (ImGui::Button("Start (space)") || options_.autopilot) startTrial();
+    return;
+  }
+  ImGui::ProgressBar(float(double(running_->loop->steps()) / double(loop_.maxSteps)));
+  if (stopped_) finishTrial();
+}
+
+void Viewer::startTrial() {
+  trialStarted_ = true;
+  paused_ = false;
+  trialBegan_ = Clock::now();
+  running_->loop->setPaused(false);
+}
+
+// The trial's loop ran its steps (run() stopped it): its record, and the next step.
+void Viewer::finishTrial() {
+  Running& r = *running_;
+  r.recorder->flush();
+  if (r.recorder->failed())
+    throw Error(
+        fmt::format("{}: the trial's signal was not recorded: {}", r.recorder->path().string(), r.recorder->error()));
+  const double wall = std::chrono::duration<double>(Clock::now() - trialBegan_).count();
+  options_.study->finishTrial({r.loop->stats().steps, wall, std::nullopt});
+  prepareStudyStep(false);
+}
+
+void Viewer::restPanel() {
+  const double left =
+      options_.study->study().restSeconds - std::chrono::duration<double>(Clock::now() - restBegan_).count();
+  if (left > 0.0 && !options_.autopilot) {
+    ImGui::TextWrapped("Time for a rest: take the glove off if you like.");
+    ImGui::ProgressBar(float(1.0 - left / options_.study->study().restSeconds), ImVec2(-1.0f, 0.0f),
+                       fmt::format("{:.0f} s", left).c_str());
+    return;
+  }
+  ImGui::TextWrapped("The rest is over.");
+  if (ImGui::Button("Continue") || options_.autopilot) {
+    options_.study->finishRest();
+    prepareStudyStep(false);
+  }
+}
+
+void Viewer::questionsPanel(const StudyStep& s) {
+  ParticipantProgress& p = *options_.study;
+  const bool last = s.kind == StudyStepKind::StudyQuestions;
+  if (!questionnaire_) questionnaire_.emplace(p.study(), p.order(), last);
+  const std::string title = last ? std::string("Every part done: a few last questions.")
+                                 : fmt::format("Part {} of {} done: how was it?", s.position + 1, p.order().size());
+  ImGui::TextUnformatted(title.c_str());
+  ImGui::Separator();
+  if (options_.autopilot) questionnaire_->answerForDryRun();
+  if (questionnaire_->draw() || options_.autopilot) {
+    if (last)
+      p.answer(questionnaire_->finalAnswers());
+    else
+      p.answer(questionnaire_->conditionAnswers());
+    prepareStudyStep(false);
+  }
+}
+
 void Viewer::screenshot(int width, int height) const {
   vrd::Image bottomUp(width, height), image(width, height);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
@@ -462,7 +638,7 @@ int Viewer::run() {
       stopped_ = true;
       try {
         running_->loop->stop();
-        error_ = "stopped: the loop ended";
+        if (!options_.study) error_ = "stopped: the loop ended";  // a study's trial ends so
       } catch (const std::exception& e) {
         error_ = fmt::format("stopped: {}", e.what());
         failed_ = true;
@@ -476,7 +652,10 @@ int Viewer::run() {
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
     handleInput(dt);
-    panels();
+    if (options_.study)
+      studyPanel();
+    else
+      panels();
     ImGui::Render();
 
     int width = 1, height = 1;
@@ -489,7 +668,7 @@ int Viewer::run() {
     running_->renderer.draw(running_->posed, s, camera_, width, height, settings);
     ++frames;
     const bool done =
-        (options_.frames > 0 && frames >= options_.frames) ||
+        (options_.frames > 0 && frames >= options_.frames) || (options_.autopilot && (studyDone() || failed_)) ||
         (options_.seconds > 0.0 && std::chrono::duration<double>(now - opened).count() >= options_.seconds);
     if (done && !options_.screenshot.empty()) screenshot(width, height);  // the 3D view, before the panels
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());

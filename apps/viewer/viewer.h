@@ -4,13 +4,16 @@
 // snapshots only; the mouse (or a WEART glove) drives the hand through a wait-free handoff; Dear
 // ImGui panels pick the scene, pause and step, change the solver live and the materials and
 // haptic parameters by rebuilding the scene, and show the per-finger forces, stage times and
-// volume loss (docs/viewer.md).
+// volume loss (docs/viewer.md). For `vrdeform study run` it walks a participant through a study
+// instead: instructions, trials, rests and the questionnaire, with the developer's panels hidden.
 
 #include <string>
 
 #include "vrdeform/render/posed_scene.h"
 
 namespace vrd {
+
+class ParticipantProgress;
 
 struct ViewerOptions {
   std::string scene = "liver";  ///< a built-in scene or a scene file
@@ -20,10 +23,14 @@ struct ViewerOptions {
   std::string weart;            ///< HOST[:PORT] of the WEART middleware; empty: the mouse is the hand
   int width = 1280, height = 800;
   ColorMap colorMap = ColorMap::None;
+  ParticipantProgress* study = nullptr;  ///< walk this participant through their study (`scene` unused)
+  bool autopilot =
+      false;  ///< with `study`: each step starts and is answered by itself, the scenes' scripted hands poke
 };
 
-/// Opens the window and runs until it closes (or `frames` are drawn). Returns 0, or 1 when no
-/// window can be opened (no display) or the simulation failed; throws vrd::Error for bad input.
+/// Opens the window and runs until it closes (or `frames` are drawn, or a study's participant is
+/// done). Returns 0, or 1 when no window can be opened (no display) or the simulation failed;
+/// throws vrd::Error for bad input.
 int runViewer(const ViewerOptions& options);
 
 }  // namespace vrd

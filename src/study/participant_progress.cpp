@@ -33,7 +33,8 @@ TrialRecord parseTrial(const fs::path& file) {
         fmt::format("{}: not a finished trial's record; delete its folder to run the trial again", file.string()));
   TrialRecord r{j["steps"].get<std::uint64_t>(), j["wall_seconds"].get<double>(), std::nullopt};
   if (isNumber(j, "felt_roughness") && isNumber(j, "felt_spearman") && isNumber(j, "felt_peak"))
-    r.felt = FeltSignal{j["felt_roughness"].get<double>(), j["felt_spearman"].get<double>(), j["felt_peak"].get<double>()};
+    r.felt =
+        FeltSignal{j["felt_roughness"].get<double>(), j["felt_spearman"].get<double>(), j["felt_peak"].get<double>()};
   return r;
 }
 
@@ -53,7 +54,8 @@ nlohmann::json readQuestionnaire(const fs::path& file, const StudySpec& s, bool 
     for (const StudyComparison& d : s.comparisons) has(scored, d.id, false);
   for (const StudyFreeText& f : s.freeTexts)
     if (f.perCondition == perCondition) has("free_text", f.id, true);
-  if (!ok) throw Error(fmt::format("{}: not a finished questionnaire's record; delete it to answer again", file.string()));
+  if (!ok)
+    throw Error(fmt::format("{}: not a finished questionnaire's record; delete it to answer again", file.string()));
   return j;
 }
 
@@ -63,7 +65,8 @@ std::size_t countFreeText(const StudySpec& s, bool perCondition) {
 }
 
 void checkScale(int value, int lo, int hi, const std::string& id) {
-  if (value < lo || value > hi) throw Error(fmt::format("answer to {}: {} is not on the scale {}..{}", id, value, lo, hi));
+  if (value < lo || value > hi)
+    throw Error(fmt::format("answer to {}: {} is not on the scale {}..{}", id, value, lo, hi));
 }
 
 void checkCount(std::size_t got, std::size_t want, const char* what) {
@@ -201,7 +204,8 @@ void ParticipantProgress::finishRest() {
 }
 
 void ParticipantProgress::answer(const ConditionAnswers& answers) {
-  if (next_.kind != StudyStepKind::ConditionQuestions) throw Error("answer: the next step is not a condition's questions");
+  if (next_.kind != StudyStepKind::ConditionQuestions)
+    throw Error("answer: the next step is not a condition's questions");
   checkCount(answers.likert.size(), study_.questions.size(), "Likert");
   checkCount(answers.freeText.size(), countFreeText(study_, true), "free-text");
   nlohmann::json j{{"condition", study_.conditions[next_.condition].name},
@@ -242,7 +246,8 @@ void ParticipantProgress::answer(const FinalAnswers& answers) {
 void ParticipantProgress::gatherAnswers() const {
   std::vector<std::optional<nlohmann::json>> byPosition(order_.size());
   for (std::size_t pos = 0; pos < order_.size(); ++pos)
-    if (fs::exists(questionnaireFile(folder_, pos))) byPosition[pos] = readQuestionnaire(questionnaireFile(folder_, pos), study_, true);
+    if (fs::exists(questionnaireFile(folder_, pos)))
+      byPosition[pos] = readQuestionnaire(questionnaireFile(folder_, pos), study_, true);
   std::optional<nlohmann::json> last;
   if (fs::exists(finalFile(folder_))) last = readQuestionnaire(finalFile(folder_), study_, false);
 

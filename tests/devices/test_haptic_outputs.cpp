@@ -138,6 +138,27 @@ TEST(HapticOutputs, SampleOfTakesPresentFingersAndSanitises) {
 
 // --- CSV recorder --------------------------------------------------------------------------------
 
+// A study's condition B: the glove gets the baseline where the force was, everything else as it came.
+TEST(HapticOutputs, BaselineAsForcePassesTheBaselineInTheForcesPlace) {
+  struct Last final : HapticOutput {
+    HapticSample sample;
+    int releases = 0;
+    void send(const HapticSample& s) override { sample = s; }
+    void release() override { ++releases; }
+  } glove;
+  BaselineAsForce b(glove);
+  const HapticSample s = makeSample(0.5, kG1);
+  b.send(s);
+  for (int f = 0; f < kFingerCount; ++f) {
+    EXPECT_EQ(glove.sample.force[f], s.baseline[f]) << f;
+    EXPECT_EQ(glove.sample.baseline[f], s.baseline[f]) << f;
+    EXPECT_EQ(glove.sample.newtons[f], s.newtons[f]) << f;
+  }
+  EXPECT_EQ(glove.sample.step, s.step);
+  b.release();
+  EXPECT_EQ(glove.releases, 1);
+}
+
 TEST(CsvRecorder, HeaderAndRowsForG1Hand) {
   TempDir dir;
   const fs::path path = dir / "g1.csv";

@@ -83,18 +83,26 @@ TEST(ParticipantProgress, WalksPracticeTrialsQuestionsAndRestsInTheParticipantsO
     }
     switch (s.kind) {
       case Kind::Practice:
-      case Kind::Trial: doTrial(p); break;
-      case Kind::Rest: p.finishRest(); break;
+      case Kind::Trial:
+        doTrial(p);
+        break;
+      case Kind::Rest:
+        p.finishRest();
+        break;
       case Kind::ConditionQuestions:
         p.answer(ConditionAnswers{{s.condition == 0 ? 5 : 2, 4}, {fmt::format("felt {}", s.position)}});
         break;
-      case Kind::StudyQuestions: p.answer(FinalAnswers{{-2}, {"A, clearly"}}); break;
-      case Kind::Done: break;
+      case Kind::StudyQuestions:
+        p.answer(FinalAnswers{{-2}, {"A, clearly"}});
+        break;
+      case Kind::Done:
+        break;
     }
   }
   EXPECT_EQ(kinds, (std::vector<Kind>{Kind::Practice, Kind::Trial, Kind::Trial, Kind::ConditionQuestions, Kind::Rest,
                                       Kind::Trial, Kind::Trial, Kind::ConditionQuestions, Kind::StudyQuestions}));
-  const nlohmann::json trial = nlohmann::json::parse(testing::readBytes(p.folder() / "trials" / "1-1-2" / "trial.json"));
+  const nlohmann::json trial =
+      nlohmann::json::parse(testing::readBytes(p.folder() / "trials" / "1-1-2" / "trial.json"));
   EXPECT_EQ(trial["condition"], "B");
   EXPECT_EQ(trial["force"], "baseline");
   EXPECT_EQ(trial["steps"], 60);

@@ -60,4 +60,20 @@ class HapticOutput {
   virtual void release() = 0;
 };
 
+/// Passes each sample on to `inner` with the condition B baseline in place of the force: the glove
+/// of a study's baseline condition gets the vendor-style signal.
+class BaselineAsForce final : public HapticOutput {
+ public:
+  explicit BaselineAsForce(HapticOutput& inner) : inner_(inner) {}
+  void send(const HapticSample& sample) override {
+    HapticSample s = sample;
+    s.force = s.baseline;
+    inner_.send(s);
+  }
+  void release() override { inner_.release(); }
+
+ private:
+  HapticOutput& inner_;
+};
+
 }  // namespace vrd

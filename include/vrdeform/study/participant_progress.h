@@ -42,9 +42,9 @@ struct FeltSignal {
 /// A finished trial, as trial.json keeps it beside what the progress adds (condition, task, trial,
 /// scene, substeps, iterations, when it finished).
 struct TrialRecord {
-  std::uint64_t steps = 0;          ///< simulation steps run
-  double wallSeconds = 0.0;         ///< how long the trial took on the wall clock
-  std::optional<FeltSignal> felt;   ///< simulated participants only
+  std::uint64_t steps = 0;         ///< simulation steps run
+  double wallSeconds = 0.0;        ///< how long the trial took on the wall clock
+  std::optional<FeltSignal> felt;  ///< simulated participants only
 };
 
 /// The answers to the questions asked after one condition.
