@@ -23,6 +23,7 @@
 #include "vrdeform/devices/csv_recorder.h"
 #include "vrdeform/devices/glove_link.h"
 #include "vrdeform/devices/haptic_output.h"
+#include "vrdeform/devices/osc_output.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
 #include "vrdeform/interact/live_hand_input.h"
@@ -33,6 +34,7 @@
 #include "vrdeform/scene/scene_library.h"
 #include "vrdeform/scene/simulation_loop.h"
 #include "vrdeform/study/participant_progress.h"
+#include "vrdeform/study/task_end.h"
 
 namespace vrd {
 namespace {
@@ -45,8 +47,9 @@ struct Running {
   BuiltScene scene;
   LiveHandInput mouseInput;
   std::optional<GloveLink> glove;
-  std::optional<BaselineAsForce> baselineGlove;  // a study's condition B: the glove gets the baseline
-  std::optional<CsvRecorder> recorder;           // a study's trial: its signal, forces.csv
+  std::optional<OscOutput> osc;                   // a study's condition on an OSC device
+  std::optional<BaselineAsForce> baselineDevice;  // a study's condition B: the device gets the baseline
+  std::optional<CsvRecorder> recorder;            // a study's trial: its signal, forces.csv
   std::unique_ptr<SimulationLoop> loop;
   std::shared_ptr<SnapshotChannel> channel;
   Snapshot settled;  // the world before the first step: drawn until the first snapshot arrives
@@ -70,12 +73,14 @@ struct Running {
 
 // How a built scene's loop runs: the viewer's defaults, or a study's trial.
 struct LoopOptions {
-  std::string weart;             // HOST[:PORT] of the WEART middleware; empty: the mouse is the hand
-  bool paused = false;           // the loop starts paused
-  bool scripted = false;         // the scene's scripted hand drives it (a study's dry run)
-  bool baseline = false;         // the glove gets the condition B baseline
-  std::uint64_t maxSteps = 0;    // 0: until stopped
-  std::filesystem::path forces;  // the signal recorded here (CSV); empty: nowhere
+  std::string weart;                        // HOST[:PORT] of the WEART middleware; empty: the mouse is the hand
+  bool paused = false;                      // the loop starts paused
+  bool scripted = false;                    // the scene's scripted hand drives it (a study's dry run)
+  bool baseline = false;                    // the device gets the condition B baseline
+  StudyDevice device = StudyDevice::Glove;  // where the force goes (a study's condition)
+  std::string osc;                          // HOST:PORT of an OSC device
+  std::uint64_t maxSteps = 0;               // 0: until stopped
+  std::filesystem::path forces;             // the signal recorded here (CSV); empty: nowhere
 };
 
 std::unique_ptr<Running> start(const SceneSpec& spec, const SceneBuildObserver& observer, const LoopOptions& o) {
@@ -88,8 +93,13 @@ std::unique_ptr<Running> start(const SceneSpec& spec, const SceneBuildObserver& 
     const Vec3 point = r->scene.actions.empty() ? r->scene.bodies.front().top : r->scene.actions.front().target;
     r->glove.emplace(o.weart, r->scene.session.hand, point);
     settings.input = &r->glove->input();
-    settings.outputs.push_back(o.baseline ? &r->baselineGlove.emplace(r->glove->output()) : &r->glove->output());
   }
+  HapticOutput* device = o.device == StudyDevice::Glove && r->glove ? &r->glove->output() : nullptr;
+  if (o.device == StudyDevice::Osc) {
+    const HostPort to = parseHostPort(o.osc);
+    device = &r->osc.emplace(to.host, to.port);
+  }
+  if (device) settings.outputs.push_back(o.baseline ? &r->baselineDevice.emplace(*device) : device);
   if (o.scripted) settings.input = nullptr;
   if (!o.forces.empty()) settings.outputs.push_back(&r->recorder.emplace(o.forces, r->scene.session.hand.fingers));
   captureSnapshot(r->settled, *r->scene.world, nullptr, 0, 0.0);
@@ -184,6 +194,8 @@ class Viewer {
   double stepWallMs_ = 0.0, frameMs_ = 0.0;
   std::uint64_t lastStep_ = 0;
   bool trialStarted_ = false;
+  std::optional<TaskEndWatch> taskEnd_;  // the trial's end condition
+  bool endConditionMet_ = false;
   Clock::time_point trialBegan_, restBegan_;
   std::optional<Questionnaire> questionnaire_;
 };
@@ -502,6 +514,10 @@ void Viewer::prepareStudyStep(bool first) {
     loop_.maxSteps = std::uint64_t(std::max(std::lround(seconds / spec_.solver.timeStep), 1L));
     loop_.forces = p.beginTrial() / "forces.csv";
     loop_.baseline = c.force == StudyForce::Baseline;
+    loop_.device = c.device;
+    loop_.osc = c.osc;
+    taskEnd_.emplace(p.task(s).end);
+    endConditionMet_ = false;
     loop_.scripted = options_.autopilot;
   } else {
     spec_ = p.study().conditions[s.kind == StudyStepKind::ConditionQuestions ? s.condition : p.order().front()].spec;
@@ -556,6 +572,11 @@ void Viewer::trialPanel(const StudyStep& s) {
     return;
   }
   ImGui::ProgressBar(float(double(running_->loop->steps()) / double(loop_.maxSteps)));
+  const Snapshot& now = running_->channel->front();
+  if (!stopped_ && now.step > 0 && taskEnd_->update(now.contact, now.grasping, now.time)) {
+    running_->loop->stop();  // the task is done before its length
+    stopped_ = endConditionMet_ = true;
+  }
   if (stopped_) finishTrial();
 }
 
@@ -574,7 +595,7 @@ void Viewer::finishTrial() {
     throw Error(
         fmt::format("{}: the trial's signal was not recorded: {}", r.recorder->path().string(), r.recorder->error()));
   const double wall = std::chrono::duration<double>(Clock::now() - trialBegan_).count();
-  options_.study->finishTrial({r.loop->stats().steps, wall, std::nullopt});
+  options_.study->finishTrial({r.loop->stats().steps, wall, std::nullopt, endConditionMet_});
   prepareStudyStep(false);
 }
 

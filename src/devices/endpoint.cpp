@@ -1,10 +1,15 @@
 #include "endpoint.h"
 
+#include <fmt/format.h>
+
 #include <arpa/inet.h>
 
 #include <algorithm>
 #include <charconv>
 #include <string>
+
+#include "vrdeform/devices/host_port.h"
+#include "vrdeform/error.h"
 
 namespace vrd {
 namespace {
@@ -67,6 +72,14 @@ std::optional<Endpoint> splitEndpoint(std::string_view text, std::string& why) {
   Endpoint out{std::string(host), std::nullopt};
   if (hasPort && !(out.port = parsePort(port))) return why = "the port must be a number from 1 to 65535", std::nullopt;
   return out;
+}
+
+HostPort parseHostPort(std::string_view text) {
+  std::string why;
+  const std::optional<Endpoint> e = splitEndpoint(text, why);
+  if (!e) throw Error(fmt::format("\"{}\": {} (expected HOST:PORT or [IPv6]:PORT)", text, why));
+  if (e->host.empty() || !e->port) throw Error(fmt::format("\"{}\": expected HOST:PORT or [IPv6]:PORT", text));
+  return {e->host, *e->port};
 }
 
 }  // namespace vrd

@@ -57,14 +57,6 @@ struct AddrInfoDeleter {
 
 }  // namespace
 
-HostPort parseHostPort(std::string_view text) {
-  std::string why;
-  const std::optional<Endpoint> e = splitEndpoint(text, why);
-  if (!e) throw Error(fmt::format("\"{}\": {} (expected HOST:PORT or [IPv6]:PORT)", text, why));
-  if (e->host.empty() || !e->port) throw Error(fmt::format("\"{}\": expected HOST:PORT or [IPv6]:PORT", text));
-  return {e->host, *e->port};
-}
-
 OscOutput::OscOutput(std::string_view host, int port, std::string_view prefix, const OscOptions& options)
     : prefix_(prefix), options_(options) {
   if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);

@@ -10,6 +10,7 @@
 #include "vrdeform/core/text_tokens.h"
 #include "vrdeform/core/write_file.h"
 #include "vrdeform/error.h"
+#include "vrdeform/study/task_end.h"
 
 namespace vrd {
 namespace {
@@ -31,7 +32,8 @@ TrialRecord parseTrial(const fs::path& file) {
   if (!j.is_object() || !isNumber(j, "steps") || !isNumber(j, "wall_seconds"))
     throw Error(
         fmt::format("{}: not a finished trial's record; delete its folder to run the trial again", file.string()));
-  TrialRecord r{j["steps"].get<std::uint64_t>(), j["wall_seconds"].get<double>(), std::nullopt};
+  TrialRecord r{j["steps"].get<std::uint64_t>(), j["wall_seconds"].get<double>(), std::nullopt,
+                j.value("ended_by", "time") != "time"};
   if (isNumber(j, "felt_roughness") && isNumber(j, "felt_spearman") && isNumber(j, "felt_peak"))
     r.felt =
         FeltSignal{j["felt_roughness"].get<double>(), j["felt_spearman"].get<double>(), j["felt_peak"].get<double>()};
@@ -173,9 +175,13 @@ void ParticipantProgress::finishTrial(const TrialRecord& record) {
                    {"trial", next_.trial},
                    {"scene", c.scene},
                    {"force", c.force == StudyForce::Baseline ? "baseline" : "multipliers"},
+                   {"device", c.device == StudyDevice::Glove  ? "glove"
+                              : c.device == StudyDevice::None ? "none"
+                                                              : "osc"},
                    {"substeps", c.spec.solver.substeps},
                    {"iterations", c.spec.solver.iterations},
                    {"steps", record.steps},
+                   {"ended_by", record.endConditionMet ? taskEndName(task(next_).end) : "time"},
                    {"wall_seconds", record.wallSeconds},
                    {"finished_utc", fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::time(nullptr)))}};
   if (record.felt) {

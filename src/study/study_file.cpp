@@ -6,6 +6,8 @@
 
 #include "scene/scene_settings_tables.h"
 #include "scene/toml_schema.h"
+#include "vrdeform/devices/host_port.h"
+#include "vrdeform/error.h"
 #include "vrdeform/metrics/latin_square.h"
 #include "vrdeform/scene/scene_library.h"
 
@@ -57,6 +59,25 @@ void readConditionSettings(const Table& t, SceneSpec& spec) {
 }
 
 constexpr Option<StudyForce> kForces[] = {{"multipliers", StudyForce::Multipliers}, {"baseline", StudyForce::Baseline}};
+constexpr Option<StudyDevice> kDevices[] = {
+    {"glove", StudyDevice::Glove}, {"none", StudyDevice::None}, {"osc", StudyDevice::Osc}};
+
+// `device` and, for "osc", its `osc` = "HOST:PORT" (required then, refused otherwise).
+void readDevice(const Table& t, StudyCondition& c) {
+  t.readChoice("device", c.device, kDevices);
+  const std::optional<Field> osc = t.get("osc");
+  if (c.device != StudyDevice::Osc) {
+    if (osc) osc->fail("only for device = \"osc\"");
+    return;
+  }
+  if (!osc) t.fail("osc", "device = \"osc\" needs osc = \"HOST:PORT\"");
+  c.osc = osc->name();
+  try {
+    parseHostPort(c.osc);
+  } catch (const Error& e) {
+    osc->fail(e.what());
+  }
+}
 
 StudySpec readStudy(const Table& root) {
   root.allowOnly({"format", "name", "description", "trials", "rest", "points", "comparison_range", "order", "condition",
@@ -76,11 +97,12 @@ StudySpec readStudy(const Table& root) {
 
   std::vector<std::string> names;
   for (const Table& t : root.tables("condition")) {
-    t.allowOnly({"name", "scene", "force", "solver", "haptics"});
+    t.allowOnly({"name", "scene", "force", "device", "osc", "solver", "haptics"});
     StudyCondition c;
     c.name = uniqueCsvName(t, "name", names);
     c.scene = readSceneName(t.require("scene"));
     t.readChoice("force", c.force, kForces);
+    readDevice(t, c);
     c.spec = loadSceneByName(c.scene);
     readConditionSettings(t, c.spec);
     s.conditions.push_back(std::move(c));
@@ -89,20 +111,24 @@ StudySpec readStudy(const Table& root) {
 
   names.clear();
   for (const Table& t : root.tables("task")) {
-    t.allowOnly({"name", "instructions", "seconds"});
+    t.allowOnly({"name", "instructions", "seconds", "end"});
     StudyTask task;
     const Field name = t.require("name");
     task.name = name.name();
     checkUnique(name, task.name, names, "name");
     t.readString("instructions", task.instructions);
     t.readNumber("seconds", task.seconds, kNonNegative);
+    constexpr Option<TaskEnd> kEnds[] = {{taskEndName(TaskEnd::Time), TaskEnd::Time},
+                                         {taskEndName(TaskEnd::Release), TaskEnd::Release},
+                                         {taskEndName(TaskEnd::GraspRelease), TaskEnd::GraspRelease}};
+    t.readChoice("end", task.end, kEnds);
     s.tasks.push_back(std::move(task));
   }
   if (s.tasks.empty()) root.fail("task", "needs at least one [[task]]");
 
   if (root.has("practice")) {
     const Table t = root.table("practice");
-    t.allowOnly({"scene", "force", "seconds", "instructions", "solver", "haptics"});
+    t.allowOnly({"scene", "force", "device", "osc", "seconds", "instructions", "solver", "haptics"});
     StudyPractice p{s.conditions.front(), {}};
     p.condition.name = p.task.name = "practice";
     if (const std::optional<Field> f = t.get("scene")) {
@@ -111,6 +137,7 @@ StudySpec readStudy(const Table& root) {
     }
     readConditionSettings(t, p.condition.spec);
     t.readChoice("force", p.condition.force, kForces);
+    if (t.has("device") || t.has("osc")) readDevice(t, p.condition);
     t.readNumber("seconds", p.task.seconds, kNonNegative);
     t.readString("instructions", p.task.instructions);
     s.practice = std::move(p);

@@ -12,6 +12,7 @@
 #include "vrdeform/metrics/signal_quality.h"
 #include "vrdeform/scene/scene_run.h"
 #include "vrdeform/study/participant_progress.h"
+#include "vrdeform/study/task_end.h"
 
 namespace vrd {
 namespace {
@@ -73,15 +74,17 @@ TrialRecord runTrial(ParticipantProgress& progress, const StudyRunSettings& sett
   run.steps = std::uint64_t(std::lround(seconds / spec.solver.timeStep));
   run.outDir = progress.beginTrial();
   std::vector<double> depth, felt;
-  bool stopped = false;
+  bool stopped = false, ended = false;
+  TaskEndWatch end(progress.task(step).end);
   run.afterStep = [&](const RunStep& s) {
     if (s.session) {  // a scene without a hand: nothing felt
       const FingerHaptics& f = s.session->haptics().fingers[int(Finger::Index)];
       depth.push_back(f.depth);
       felt.push_back(c.force == StudyForce::Baseline ? f.baseline : f.force);
+      ended = end.update(s.session->inContact(), s.session->grasp().active(), s.time);
     }
     stopped = settings.stop && settings.stop();
-    return !stopped;
+    return !stopped && !ended;
   };
   const auto began = std::chrono::steady_clock::now();
   const RunSummary summary = runScene(scene, run);
@@ -93,7 +96,7 @@ TrialRecord runTrial(ParticipantProgress& progress, const StudyRunSettings& sett
   }
   const TrialRecord record{summary.steps,
                            std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count(),
-                           feltInTrial(spec, depth, felt)};
+                           feltInTrial(spec, depth, felt), ended};
   progress.finishTrial(record);
   return record;
 }

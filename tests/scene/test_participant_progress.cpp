@@ -14,6 +14,7 @@
 #include "vrdeform/study/participant_progress.h"
 #include "vrdeform/study/study_analysis.h"
 #include "vrdeform/study/study_file.h"
+#include "vrdeform/study/task_end.h"
 
 namespace vrd {
 namespace {
@@ -191,6 +192,25 @@ TEST(ParticipantProgress, ABrokenRecordIsNamedBeforeAnyWork) {
     EXPECT_NE(std::string(e.what()).find("1.json: not a finished questionnaire's record"), std::string::npos)
         << e.what();
   }
+}
+
+// A poke ends half a second after the hand let go; a grasp task when the grasp lets go; a lift
+// between two presses does not end a poke.
+TEST(TaskEndWatch, EndsAPokeOnReleaseAndAGraspWhenItLetsGo) {
+  TaskEndWatch time(TaskEnd::Time), poke(TaskEnd::Release), grasp(TaskEnd::GraspRelease);
+  const double dt = 0.01;
+  int pokeEnded = -1, graspEnded = -1;
+  for (int k = 0; k < 400; ++k) {
+    const double t = k * dt;
+    // Touching 0.5-1.0 s, lifted 0.3 s, touching again 1.3-2.0 s (a grasp 1.5-1.8 s), then free.
+    const bool grasping = t >= 1.5 && t < 1.8;
+    const bool contact = (t >= 0.5 && t < 1.0) || (t >= 1.3 && t < 2.0);
+    EXPECT_FALSE(time.update(contact, grasping, t));
+    if (poke.update(contact, grasping, t) && pokeEnded < 0) pokeEnded = k;
+    if (grasp.update(contact, grasping, t) && graspEnded < 0) graspEnded = k;
+  }
+  EXPECT_EQ(pokeEnded, 249);   // the last contact at step 199 (1.99 s), half a second later
+  EXPECT_EQ(graspEnded, 180);  // the first step without the grasp
 }
 
 }  // namespace

@@ -108,9 +108,11 @@ TEST(StudyFile, APracticeTrialComesFirst) {
             "jelly");
   EXPECT_EQ(studyError(std::string(kSmall) + "[practice]\nscene = \"jely\"\n").substr(0, 40),
             "s.toml:24: practice.scene: no built-in s");
-  EXPECT_EQ(studyError(std::string(kSmall) + "[practice]\ntrials = 2\n"),
-            "s.toml:24: practice.trials: unknown key (expected one of: scene, force, seconds, instructions, solver, "
-            "haptics)");
+  EXPECT_EQ(
+      studyError(std::string(kSmall) + "[practice]\ntrials = 2\n"),
+      "s.toml:24: practice.trials: unknown key (expected one of: scene, force, device, osc, seconds, instructions, "
+      "solver, "
+      "haptics)");
   // On the first condition's scene, its solver keys over the condition's.
   const StudySpec tuned = parseStudy(std::string(kSmall) + "[practice.solver]\niterations = 2\n", "s.toml", ".");
   ASSERT_TRUE(tuned.practice);
@@ -150,7 +152,41 @@ TEST(StudyFile, AConditionSetsItsOwnSolverAndHapticSettings) {
   EXPECT_EQ(studyError(with("[condition.haptics]\nalpah = 0.5\n")),
             "s.toml:11: condition[2].haptics.alpah: unknown key (did you mean 'alpha'?)");
   EXPECT_EQ(studyError(with("[condition.output]\nplots = false\n")),
-            "s.toml:10: condition[2].output: unknown key (expected one of: name, scene, force, solver, haptics)");
+            "s.toml:10: condition[2].output: unknown key (expected one of: name, scene, force, device, osc, solver, "
+            "haptics)");
+}
+
+// Where each condition's force goes, and when a task's trial ends.
+TEST(StudyFile, ConditionsNameTheirDeviceAndTasksTheirEnd) {
+  std::string text = kSmall;
+  const std::string afterB = "force = \"baseline\"\n";  // condition B, line 9
+  text.insert(text.find(afterB) + afterB.size(), "device = \"osc\"\nosc = \"127.0.0.1:9000\"\n");
+  const std::string afterC = "scene = \"jelly\"\n";
+  text.insert(text.find(afterC) + afterC.size(), "device = \"none\"\n");
+  const std::string afterTask = "name = \"poke\"\n";
+  text.insert(text.find(afterTask) + afterTask.size(), "end = \"release\"\nseconds = 20\n");
+  const StudySpec s = parseStudy(text, "s.toml", ".");
+  EXPECT_EQ(s.conditions[0].device, StudyDevice::Glove);
+  EXPECT_EQ(s.conditions[1].device, StudyDevice::Osc);
+  EXPECT_EQ(s.conditions[1].osc, "127.0.0.1:9000");
+  EXPECT_EQ(s.conditions[2].device, StudyDevice::None);
+  EXPECT_EQ(s.tasks[0].end, TaskEnd::Release);
+  EXPECT_EQ(s.tasks[0].seconds, 20.0);
+
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = text;
+    t.replace(t.find(from), from.size(), to);
+    return studyError(t);
+  };
+  EXPECT_EQ(with("osc = \"127.0.0.1:9000\"\n", ""),
+            "s.toml:6: condition[2].osc: device = \"osc\" needs osc = \"HOST:PORT\"");
+  EXPECT_EQ(with("127.0.0.1:9000", "127.0.0.1"),
+            "s.toml:11: condition[2].osc: \"127.0.0.1\": expected HOST:PORT or [IPv6]:PORT");
+  EXPECT_EQ(with("device = \"osc\"", "device = \"glove\""), "s.toml:11: condition[2].osc: only for device = \"osc\"");
+  EXPECT_EQ(with("device = \"none\"", "device = \"haptx\""),
+            "s.toml:15: condition[3].device: unknown value 'haptx' (expected one of: glove, none, osc)");
+  EXPECT_EQ(with("end = \"release\"", "end = \"lift\""),
+            "s.toml:18: task[1].end: unknown value 'lift' (expected one of: time, release, grasp_release)");
 }
 
 TEST(StudyFile, MistakesAreNamedWithLineAndKey) {

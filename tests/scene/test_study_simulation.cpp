@@ -167,6 +167,25 @@ TEST(StudySimulation, EachConditionRunsWithItsOwnSolverSettings) {
   }
 }
 
+// A task that ends when the hand lets go: the liver's poke releases at 3-4 s, so the trial ends
+// half a second after, not at its 8 s, and says so.
+TEST(StudySimulation, ATrialEndsWhenItsTasksEndConditionIsMet) {
+  std::string text = kSimulatedStudy;
+  text.replace(text.find("seconds = 4.5"), 13, "seconds = 8\nend = \"release\"");
+  const StudySpec study = parseStudy(text, "release.toml", ".");
+  RunFolder data("release");
+  StudyRunSettings s;
+  s.dataDir = data.path;
+  EXPECT_EQ(runSimulatedParticipant(study, s).trialsRun, 2u);
+  for (const char* trialDir : {"1-1-1", "2-1-1"}) {
+    const nlohmann::json trial =
+        nlohmann::json::parse(readBytes(testing::participantFolder(data.path, 1) / "trials" / trialDir / "trial.json"));
+    EXPECT_EQ(trial["ended_by"], "release") << trialDir;
+    EXPECT_GE(trial["steps"].get<int>(), 180) << trialDir;  // at least the approach and hold, 3 s
+    EXPECT_LE(trial["steps"].get<int>(), 270) << trialDir;  // before the pinch at 4.5 s
+  }
+}
+
 TEST(StudySimulation, AStoppedRunResumesKeepingEveryFinishedTrial) {
   const StudySpec study = parseStudy(kSimulatedStudy, "poke.toml", ".");
   RunFolder data("resumed"), whole("whole");

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "vrdeform/devices/haptic_output.h"
+#include "vrdeform/devices/host_port.h"
 
 namespace vrd {
 
@@ -30,14 +31,6 @@ struct OscOptions {
   /// messages, for receivers that do not unpack bundles.
   bool bundle = true;
 };
-
-struct HostPort {
-  std::string host;
-  int port = 0;
-};
-
-/// Splits "HOST:PORT" (IPv6 as "[::1]:9000"); throws vrd::Error without a port in 1..65535.
-HostPort parseHostPort(std::string_view text);
 
 class OscOutput final : public HapticOutput {
  public:

@@ -45,6 +45,7 @@ struct TrialRecord {
   std::uint64_t steps = 0;         ///< simulation steps run
   double wallSeconds = 0.0;        ///< how long the trial took on the wall clock
   std::optional<FeltSignal> felt;  ///< simulated participants only
+  bool endConditionMet = false;    ///< the task's end condition ended it, not its length
 };
 
 /// The answers to the questions asked after one condition.

@@ -18,19 +18,34 @@ namespace vrd {
 /// through Algorithm 2) or condition B (the vendor-style baseline, haptics/baseline.h).
 enum class StudyForce { Multipliers, Baseline };
 
+/// Where a condition's force goes: the participant's WEART glove (`study run --weart`), nowhere (a
+/// visual-only condition: the glove, if any, still tracks the hand but gets no force), or OSC over UDP
+/// to another device (the glove, if any, tracks the hand).
+enum class StudyDevice { Glove, None, Osc };
+
 struct StudyCondition {
   std::string name;   ///< unique; the data and the analysis name conditions by it
   std::string scene;  ///< a built-in scene's name or a scene file (absolute once loaded)
   StudyForce force = StudyForce::Multipliers;
+  StudyDevice device = StudyDevice::Glove;
+  std::string osc;  ///< HOST:PORT of the OSC device (StudyDevice::Osc)
   /// The scene as the condition runs it: loaded, with the condition's own [solver] and [haptics]
   /// keys over the scene's (the rest as the scene has it).
   SceneSpec spec;
 };
 
+/// When a task's trial ends before its length (study/task_end.h).
+enum class TaskEnd {
+  Time,          ///< after `seconds`
+  Release,       ///< once the hand has touched a body and then left it untouched for half a second
+  GraspRelease,  ///< once a grasp has held a body and then let it go
+};
+
 struct StudyTask {
   std::string name;          ///< unique, e.g. "poke"
   std::string instructions;  ///< shown to the participant before the task's first trial
-  double seconds = 0.0;      ///< how long a trial lasts; 0: the scene's own length
+  double seconds = 0.0;      ///< how long a trial lasts at most; 0: the scene's own length
+  TaskEnd end = TaskEnd::Time;
 };
 
 /// A practice trial before the first condition, so that the participant learns the set-up; its data
