@@ -20,6 +20,7 @@
 #include <optional>
 #include <vector>
 
+#include "vrdeform/core/write_file.h"
 #include "vrdeform/devices/csv_recorder.h"
 #include "vrdeform/devices/glove_link.h"
 #include "vrdeform/devices/haptic_output.h"
@@ -27,6 +28,7 @@
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
 #include "vrdeform/interact/live_hand_input.h"
+#include "vrdeform/metrics/latency_stats.h"
 #include "vrdeform/render/gl_driver.h"
 #include "vrdeform/render/image.h"
 #include "vrdeform/render/mouse_hand.h"
@@ -35,6 +37,7 @@
 #include "vrdeform/scene/simulation_loop.h"
 #include "vrdeform/study/participant_progress.h"
 #include "vrdeform/study/task_end.h"
+#include "vrdeform/study/trial_events.h"
 
 namespace vrd {
 namespace {
@@ -50,6 +53,7 @@ struct Running {
   std::optional<OscOutput> osc;                   // a study's condition on an OSC device
   std::optional<BaselineAsForce> baselineDevice;  // a study's condition B: the device gets the baseline
   std::optional<CsvRecorder> recorder;            // a study's trial: its signal, forces.csv
+  std::optional<TrialEvents> events;              // and its task events
   std::unique_ptr<SimulationLoop> loop;
   std::shared_ptr<SnapshotChannel> channel;
   Snapshot settled;  // the world before the first step: drawn until the first snapshot arrives
@@ -80,7 +84,7 @@ struct LoopOptions {
   StudyDevice device = StudyDevice::Glove;  // where the force goes (a study's condition)
   std::string osc;                          // HOST:PORT of an OSC device
   std::uint64_t maxSteps = 0;               // 0: until stopped
-  std::filesystem::path forces;             // the signal recorded here (CSV); empty: nowhere
+  std::filesystem::path forces;             // the signal recorded here (CSV), the task events beside it
 };
 
 std::unique_ptr<Running> start(const SceneSpec& spec, const SceneBuildObserver& observer, const LoopOptions& o) {
@@ -101,7 +105,10 @@ std::unique_ptr<Running> start(const SceneSpec& spec, const SceneBuildObserver& 
   }
   if (device) settings.outputs.push_back(o.baseline ? &r->baselineDevice.emplace(*device) : device);
   if (o.scripted) settings.input = nullptr;
-  if (!o.forces.empty()) settings.outputs.push_back(&r->recorder.emplace(o.forces, r->scene.session.hand.fingers));
+  if (!o.forces.empty()) {
+    settings.outputs.push_back(&r->recorder.emplace(o.forces, r->scene.session.hand.fingers));
+    settings.outputs.push_back(&r->events.emplace());
+  }
   captureSnapshot(r->settled, *r->scene.world, nullptr, 0, 0.0);
   captureConstraintForces(r->settled, *r->scene.world);
   r->posed.pose(r->settled, ColorMap::None);
@@ -595,6 +602,9 @@ void Viewer::finishTrial() {
     throw Error(
         fmt::format("{}: the trial's signal was not recorded: {}", r.recorder->path().string(), r.recorder->error()));
   const double wall = std::chrono::duration<double>(Clock::now() - trialBegan_).count();
+  const std::filesystem::path dir = r.recorder->path().parent_path();
+  writeFile(dir / "events.csv", r.events->csv());
+  writeFile(dir / "latency.csv", latencyCsv(r.loop->latency()));
   options_.study->finishTrial({r.loop->stats().steps, wall, std::nullopt, endConditionMet_});
   prepareStudyStep(false);
 }

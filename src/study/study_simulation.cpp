@@ -8,11 +8,13 @@
 #include <random>
 #include <vector>
 
+#include "vrdeform/core/write_file.h"
 #include "vrdeform/error.h"
 #include "vrdeform/metrics/signal_quality.h"
 #include "vrdeform/scene/scene_run.h"
 #include "vrdeform/study/participant_progress.h"
 #include "vrdeform/study/task_end.h"
+#include "vrdeform/study/trial_events.h"
 
 namespace vrd {
 namespace {
@@ -76,6 +78,8 @@ TrialRecord runTrial(ParticipantProgress& progress, const StudyRunSettings& sett
   std::vector<double> depth, felt;
   bool stopped = false, ended = false;
   TaskEndWatch end(progress.task(step).end);
+  TrialEvents events;
+  run.outputs.push_back(&events);
   run.afterStep = [&](const RunStep& s) {
     if (s.session) {  // a scene without a hand: nothing felt
       const FingerHaptics& f = s.session->haptics().fingers[int(Finger::Index)];
@@ -94,6 +98,7 @@ TrialRecord runTrial(ParticipantProgress& progress, const StudyRunSettings& sett
     throw Stopped(
         fmt::format("stopped during trial {} of {} in condition {}", step.trial, progress.task(step).name, c.name));
   }
+  writeFile(run.outDir / "events.csv", events.csv());
   const TrialRecord record{summary.steps,
                            std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count(),
                            feltInTrial(spec, depth, felt), ended};

@@ -89,5 +89,7 @@ for t in 1 2; do
   grep -q '"ended_by": "release"' "$record" || fail "P3's trial $t was not ended by the release: $(cat "$record")"
   steps=$(sed -n 's/.*"steps": \([0-9]*\).*/\1/p' "$record")
   [ "$steps" -ge 180 ] && [ "$steps" -le 300 ] || fail "P3's trial $t ran $steps steps, not 180..300"
+  grep -q ",touch,index" "$data/P3/trials/$t-1-1/events.csv" || fail "P3's trial $t: no touch in events.csv"
+  grep -q "^contact,total," "$data/P3/trials/$t-1-1/latency.csv" || fail "P3's trial $t: no latency.csv"
 done
 echo "PASS: P1 and P2 walked the study in their orders; P3 stopped after a trial and went on from there"

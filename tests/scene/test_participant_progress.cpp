@@ -15,6 +15,7 @@
 #include "vrdeform/study/study_analysis.h"
 #include "vrdeform/study/study_file.h"
 #include "vrdeform/study/task_end.h"
+#include "vrdeform/study/trial_events.h"
 
 namespace vrd {
 namespace {
@@ -211,6 +212,25 @@ TEST(TaskEndWatch, EndsAPokeOnReleaseAndAGraspWhenItLetsGo) {
   }
   EXPECT_EQ(pokeEnded, 249);   // the last contact at step 199 (1.99 s), half a second later
   EXPECT_EQ(graspEnded, 180);  // the first step without the grasp
+}
+
+// Each finger's touches and the grasps, at the step they begin and end; absent fingers say nothing.
+TEST(TrialEvents, NameEachTouchAndGraspAtItsStep) {
+  TrialEvents events;
+  for (std::uint64_t k = 1; k <= 8; ++k) {
+    HapticSample s;
+    s.step = k;
+    s.time = 0.5 * double(k);
+    s.present = {true, true, true, false, false};
+    s.contacts[1] = k >= 3 && k <= 5 ? 2u : 0u;  // index
+    s.contacts[0] = k >= 4 && k <= 6 ? 1u : 0u;  // thumb
+    s.contacts[3] = 7;                           // ring: not on this hand
+    s.grasp = k >= 4 && k <= 5;
+    events.send(s);
+  }
+  EXPECT_EQ(events.csv(),
+            "step,time_s,event,finger\n3,1.5,touch,index\n4,2,touch,thumb\n4,2,grasp,\n6,3,untouch,index\n"
+            "6,3,ungrasp,\n7,3.5,untouch,thumb\n");
 }
 
 }  // namespace

@@ -183,6 +183,12 @@ TEST(StudySimulation, ATrialEndsWhenItsTasksEndConditionIsMet) {
     EXPECT_EQ(trial["ended_by"], "release") << trialDir;
     EXPECT_GE(trial["steps"].get<int>(), 180) << trialDir;  // at least the approach and hold, 3 s
     EXPECT_LE(trial["steps"].get<int>(), 270) << trialDir;  // before the pinch at 4.5 s
+    // The index touched the liver, then let go: the last event, half a second before the end.
+    const std::string events = readBytes(testing::participantFolder(data.path, 1) / "trials" / trialDir / "events.csv");
+    EXPECT_NE(events.find(",touch,index\n"), std::string::npos) << events;
+    const std::size_t last = events.rfind(",untouch,index\n");
+    ASSERT_NE(last, std::string::npos) << events;
+    EXPECT_EQ(last + std::string(",untouch,index\n").size(), events.size()) << events;
   }
 }
 

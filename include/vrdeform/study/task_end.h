@@ -23,9 +23,12 @@ class TaskEndWatch {
     }
     grasped_ = grasped_ || grasping;
     switch (end_) {
-      case TaskEnd::Time: return false;
-      case TaskEnd::Release: return touched_ && !contact && time - lastContact_ >= kReleaseSeconds;
-      case TaskEnd::GraspRelease: return grasped_ && !grasping;
+      case TaskEnd::Time:
+        return false;
+      case TaskEnd::Release:
+        return touched_ && !contact && time - lastContact_ >= kReleaseSeconds;
+      case TaskEnd::GraspRelease:
+        return grasped_ && !grasping;
     }
     return false;
   }
