@@ -21,6 +21,10 @@ fs::path questionnaireFile(const fs::path& folder, std::size_t position) {
   return folder / "questionnaires" / fmt::format("{}.json", position + 1);
 }
 fs::path finalFile(const fs::path& folder) { return folder / "questionnaires" / "final.json"; }
+// Where a trial's files are written while it runs.
+fs::path scratchOf(const fs::path& trialFolder) {
+  return trialFolder.parent_path() / (trialFolder.filename().string() + ".partial");
+}
 
 nlohmann::json readJson(const fs::path& file) { return nlohmann::json::parse(io::readFileBytes(file), nullptr, false); }
 
@@ -33,7 +37,7 @@ TrialRecord parseTrial(const fs::path& file) {
     throw Error(
         fmt::format("{}: not a finished trial's record; delete its folder to run the trial again", file.string()));
   TrialRecord r{j["steps"].get<std::uint64_t>(), j["wall_seconds"].get<double>(), std::nullopt,
-                j.value("ended_by", "time") != "time"};
+                j.contains("ended_by") && j["ended_by"].is_string() && j["ended_by"] != "time"};
   if (isNumber(j, "felt_roughness") && isNumber(j, "felt_spearman") && isNumber(j, "felt_peak"))
     r.felt =
         FeltSignal{j["felt_roughness"].get<double>(), j["felt_spearman"].get<double>(), j["felt_peak"].get<double>()};
@@ -158,8 +162,7 @@ void ParticipantProgress::advance() {
 fs::path ParticipantProgress::beginTrial() {
   if (next_.kind != StudyStepKind::Trial && next_.kind != StudyStepKind::Practice)
     throw Error("beginTrial: the next step is not a trial");
-  const fs::path dir = trialFolder(next_);
-  const fs::path partial = dir.parent_path() / (dir.filename().string() + ".partial");
+  const fs::path partial = scratchOf(trialFolder(next_));
   std::error_code error;
   fs::remove_all(partial, error);  // what a killed run left
   prepareOutputFolder(partial);
@@ -189,8 +192,7 @@ void ParticipantProgress::finishTrial(const TrialRecord& record) {
     j["felt_spearman"] = record.felt->spearman;
     j["felt_peak"] = record.felt->peak;
   }
-  const fs::path dir = trialFolder(next_);
-  const fs::path partial = dir.parent_path() / (dir.filename().string() + ".partial");
+  const fs::path dir = trialFolder(next_), partial = scratchOf(dir);
   writeFile(partial / "trial.json", j.dump(2) + "\n");
   std::error_code error;
   fs::rename(partial, dir, error);  // the finished trial appears whole
