@@ -15,6 +15,7 @@
 #include "vrdeform/study/study_analysis.h"
 #include "vrdeform/study/study_file.h"
 #include "vrdeform/study/study_simulation.h"
+#include "vrdeform/study/task_end.h"
 
 namespace vrd {
 namespace {
@@ -35,12 +36,20 @@ int check(const StudyArgs& a) {
       s.comparisons.size(), s.freeTexts.size());
   const auto describe = [](const StudyCondition& c) {
     const SolverSettings& solver = c.spec.solver;
-    return fmt::format("scene {} ({} substeps x {} iterations at {:g} Hz), force {}", c.scene, solver.substeps,
+    const std::string device = c.device == StudyDevice::Glove  ? "the glove"
+                               : c.device == StudyDevice::None ? "no device (visual only)"
+                                                               : "OSC to " + c.osc;
+    return fmt::format("scene {} ({} substeps x {} iterations at {:g} Hz), force {} to {}", c.scene, solver.substeps,
                        solver.iterations, 1.0 / solver.timeStep,
-                       c.force == StudyForce::Multipliers ? "multipliers (A)" : "baseline (B)");
+                       c.force == StudyForce::Multipliers ? "multipliers (A)" : "baseline (B)", device);
   };
   if (s.practice) fmt::print("  practice first: {}\n", describe(s.practice->condition));
   for (const StudyCondition& c : s.conditions) fmt::print("  condition {}: {}\n", c.name, describe(c));
+  for (const StudyTask& t : s.tasks) {
+    const std::string length = t.seconds > 0.0 ? fmt::format("{:g} s", t.seconds) : "the scene's length";
+    fmt::print("  task {}: {}\n", t.name,
+               t.end == TaskEnd::Time ? length : fmt::format("until {}, at most {}", taskEndName(t.end), length));
+  }
   const std::size_t n = a.participants > 0 ? a.participants : 2 * s.conditions.size();
   for (std::size_t k = 1; k <= n; ++k) {
     std::vector<std::string_view> order;
