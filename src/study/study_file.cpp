@@ -10,6 +10,7 @@
 #include "vrdeform/error.h"
 #include "vrdeform/metrics/latin_square.h"
 #include "vrdeform/scene/scene_library.h"
+#include "vrdeform/study/task_end.h"
 
 namespace vrd {
 namespace {
