@@ -58,6 +58,15 @@ World::ContactSurface World::contactSurfaceOf(const BodyModel& model) {
   };
   sortUnique(surface.vertices);
   sortUnique(surface.edges);
+  surface.edgeFaces.assign(surface.edges.size(), {ContactSurface::kNoFace, ContactSurface::kNoFace});
+  for (Index t = 0; t < model.surface.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const Triangle& tri = model.surface[t];
+      const std::array<Index, 2> e{std::min(tri[k], tri[(k + 1) % 3]), std::max(tri[k], tri[(k + 1) % 3])};
+      std::array<Index, 2>& faces = surface.edgeFaces[std::size_t(
+          std::lower_bound(surface.edges.begin(), surface.edges.end(), e) - surface.edges.begin())];
+      faces[faces[0] == ContactSurface::kNoFace ? 0 : 1] = t;
+    }
   return surface;
 }
 
@@ -117,6 +126,7 @@ void World::detectBodyContacts() {
     for (const std::array<Index, 2>& e : contactSurfaces_[id].edges)
       broad.edgeBoxes.push_back(sweptBox(b.firstParticle + e[0], broad.offset, grow)
                                     .extend(sweptBox(b.firstParticle + e[1], broad.offset, grow)));
+    markCreases(id);
     // Cells the size of a typical triangle's box: a vertex's box meets a few cells, a triangle's a few.
     broad.hash.build(broad.boxes, std::max(float(extent / double(broad.boxes.size())), 1e-6f));
     broad.edgeHash.build(broad.edgeBoxes, std::max(float(extent / double(broad.boxes.size())), 1e-6f));
@@ -134,6 +144,30 @@ void World::detectBodyContacts() {
   // The order the warm start matches contacts in.
   std::sort(bodyContacts_.begin(), bodyContacts_.end(),
             [](const BodyContact& x, const BodyContact& y) { return x.key < y.key; });
+}
+
+// Self-contact of a closed surface needs edge pairs only where an edge is a crease: between two
+// smooth stretches of surface a vertex meets the other side's faces before any edge can cross
+// between vertices. Creases from the substep's start (a fold makes new ones), by the angle between
+// the edge's two faces; a boundary edge (a surface that is not closed) counts as one.
+void World::markCreases(BodyId id) {
+  ContactBroadPhase& broad = broadPhases_[id];
+  const Body& b = bodies_[id];
+  broad.sharp.clear();
+  if (!bodyContactSettings_[id].self || b.model->tets.empty()) return;  // every edge of a cloth or between bodies
+  const ContactSurface& surface = contactSurfaces_[id];
+  const auto normal = [&](Index t) {
+    const Triangle& tri = b.model->surface[t];
+    const Vec3 &x0 = local_[b.firstParticle + tri[0]].pos, &x1 = local_[b.firstParticle + tri[1]].pos,
+               &x2 = local_[b.firstParticle + tri[2]].pos;
+    return (x1 - x0).cross(x2 - x0).normalized();
+  };
+  constexpr float kCreaseCos = 0.866f;  // faces more than 30 degrees apart
+  broad.sharp.resize(surface.edges.size());
+  for (std::size_t e = 0; e < surface.edges.size(); ++e) {
+    const std::array<Index, 2>& f = surface.edgeFaces[e];
+    broad.sharp[e] = f[1] == ContactSurface::kNoFace || !(normal(f[0]).dot(normal(f[1])) > kCreaseCos);
+  }
 }
 
 namespace {
@@ -200,17 +234,24 @@ void World::detectEdgeEdge(BodyId a, BodyId bId) {
   const std::vector<Vec3>& rest = body.model->restPositions;
   const ContactPair pair = contactPair(bodyContactSettings_[a], bodyContactSettings_[bId]);
   const float gap = pair.gap;
-  for (Index e = 0; e < surfaceA.edges.size(); ++e) {
-    const std::array<Index, 2>& edge = surfaceA.edges[e];
-    const Index i0 = body.firstParticle + edge[0], i1 = body.firstParticle + edge[1];
-    const Box3f& box = broadPhases_[a].edgeBoxes[e];
+  // Within a body in self-contact, only creases query (broad.sharp); a pair of two creases once.
+  const std::vector<char>& sharp = broad.sharp;
+  for (Index queried = 0; queried < surfaceA.edges.size(); ++queried) {
+    if (!sharp.empty() && !sharp[queried]) continue;
+    const Box3f& box = broadPhases_[a].edgeBoxes[queried];
     if (!box.intersects(broad.bounds)) continue;
-    const float motion = std::max((pred[i0].pos - start[i0].pos).norm(), (pred[i1].pos - start[i1].pos).norm());
     const std::uint32_t query = ++contactQuery_;
-    broad.edgeHash.query(box, [&](Index f) {
-      if ((a == bId && f <= e) || seen_[f] == query) return;
-      seen_[f] = query;
-      if (!box.intersects(broad.edgeBoxes[f])) return;
+    broad.edgeHash.query(box, [&](Index met) {
+      if (seen_[met] == query) return;
+      seen_[met] = query;
+      if (a == bId && (met == queried || (met < queried && (sharp.empty() || sharp[met])))) return;
+      if (!box.intersects(broad.edgeBoxes[met])) return;
+      // Within a body, each pair from its lower edge, whichever found it: the same contact (key,
+      // corner order) from every substep, for the warm start.
+      const Index e = a == bId ? std::min(queried, met) : queried, f = a == bId ? std::max(queried, met) : met;
+      const std::array<Index, 2>& edge = surfaceA.edges[e];
+      const Index i0 = body.firstParticle + edge[0], i1 = body.firstParticle + edge[1];
+      const float motion = std::max((pred[i0].pos - start[i0].pos).norm(), (pred[i1].pos - start[i1].pos).norm());
       const std::array<Index, 2>& g = surfaceB.edges[f];
       if (a == bId && shareCorner(std::span(edge), std::span(g))) return;
       const std::array<Index, 4> p{i0, i1, other.firstParticle + g[0], other.firstParticle + g[1]};

@@ -222,6 +222,58 @@ TEST(BodyContact, ABarFoldedOntoItselfNeverCrossesItsOwnSurface) {
   EXPECT_EQ(foldCrossings(true), 0);
 }
 
+// Two ridges of one body crossing at right angles, each a single 20 cm edge (a square bar turned
+// 45 degrees about its length, one across the other): the upper bar, moved as a whole (kinematic),
+// presses its ridge 1 cm into the lower one's, whose bottom ridge is held. They meet halfway along
+// both edges, 10 cm from any vertex, where only an edge pair can hold them: with self-contact the
+// creases are taken as edge pairs, and the surface never crosses itself.
+TEST(BodyContact, CrossedRidgesOfOneBodyMeetAsEdgesNotVertices) {
+  const auto run = [](bool self, std::size_t* edgePairs) {
+    SolverSettings s;
+    s.gravity = Vec3::Zero();
+    s.substeps = 8;
+    s.iterations = 10;
+    World w(s);
+    constexpr float kSide = 0.03f, kLength = 0.2f;
+    const TetMesh bar =
+        makeBoxTets(Vec3(-0.5f * kSide, -0.5f * kSide, -0.5f * kLength), Vec3(kSide, kSide, kLength), 1, 1, 1);
+    const Eigen::AngleAxisf lower(float(M_PI) / 4.0f, Vec3::UnitZ());  // ridge up, along z
+    const Eigen::Matrix3f upper = (Eigen::AngleAxisf(float(M_PI) / 2.0f, Vec3::UnitY()) * lower).toRotationMatrix();
+    const float halfDiagonal = kSide / std::sqrt(2.0f);
+    TetMesh both;
+    for (const Vec3& v : bar.vertices) both.vertices.push_back(lower * v);
+    for (const Vec3& v : bar.vertices)
+      both.vertices.push_back(upper * v + Vec3(0.0f, 2.0f * halfDiagonal + 0.002f, 0.0f));
+    both.tets = bar.tets;
+    const Index n = Index(bar.vertices.size());
+    for (Tet t : bar.tets) both.tets.push_back({t[0] + n, t[1] + n, t[2] + n, t[3] + n});
+    Material m;
+    m.elastic = ElasticModuli{1e5f, 0.3f, 1000.0f};
+    const BodyId body = w.addBody(makeSoftBody(both, m, {false, true, true, false}));
+    BodyContactSettings contact;
+    contact.self = self;
+    w.setBodyContact(body, contact);
+    for (Index i = 0; i < 2 * n; ++i) {
+      const Index p = w.particleIndex(body, i);
+      if (i >= n || w.particles().x[p].pos.y() < -0.9f * halfDiagonal) w.setInverseMass(p, 0.0f);
+    }
+    const int steps = 18;
+    int crossings = 0;
+    for (int step = 0; step < steps; ++step) {
+      for (Index i = n; i < 2 * n; ++i)  // 12 mm down over the first 12 steps (0.06 m/s), then held
+        w.particles().v[w.particleIndex(body, i)] = Vec3(0.0f, step < 12 ? -0.06f : 0.0f, 0.0f);
+      w.step();
+      crossings += crossing(surfaces(w, {body})) ? 1 : 0;
+    }
+    for (const BodyContact& c : w.bodyContacts()) *edgePairs += c.firstCorners == 2 ? 1 : 0;
+    return crossings;
+  };
+  std::size_t edgePairs = 0;
+  EXPECT_GT(run(false, &edgePairs), 0) << "without self-contact the ridges should pass into each other";
+  EXPECT_EQ(run(true, &edgePairs), 0);
+  EXPECT_GT(edgePairs, 0u) << "the ridges should be held as a pair of edges";
+}
+
 // A body at rest touches itself nowhere: self-contact then pushes nothing, and the block settles
 // bit for bit as it does without it.
 TEST(BodyContact, SelfContactLeavesABodyAtRestAsItWas) {

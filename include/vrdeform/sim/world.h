@@ -254,11 +254,14 @@ class World {
   std::vector<std::array<Vec3, 3>> fingertipTriangleImpulse_;  // per corner: sum of grad C dLambda this substep
   // Body contact: each body's settings and surface, the pairs switched off, the contacts.
   struct ContactSurface {
-    std::vector<Index> vertices;                   // the surface's vertices (body-local, ascending)
-    std::vector<std::array<Index, 2>> edges;       // its edges (body-local, lower first, ascending)
+    std::vector<Index> vertices;                  // the surface's vertices (body-local, ascending)
+    std::vector<std::array<Index, 2>> edges;      // its edges (body-local, lower first, ascending)
+    std::vector<std::array<Index, 2>> edgeFaces;  // per edge, its surface triangles (kNoFace: none)
+    static constexpr Index kNoFace = ~Index(0);
     Index firstTriangleKey = 0, firstEdgeKey = 0;  // world-wide numbers of its first triangle and edge
   };
   static ContactSurface contactSurfaceOf(const BodyModel& model);
+  void markCreases(BodyId id);
   std::vector<BodyContactSettings> bodyContactSettings_;
   std::vector<ContactSurface> contactSurfaces_;
   std::vector<std::pair<BodyId, BodyId>> pairsOff_;  // (lower, higher), sorted
@@ -270,6 +273,7 @@ class World {
   struct ContactBroadPhase {
     std::vector<Box3f> boxes;      // per surface triangle
     std::vector<Box3f> edgeBoxes;  // per surface edge
+    std::vector<char> sharp;       // per surface edge of a body in self-contact: a crease (detectBodyContacts)
     Box3f bounds;
     Vec3 offset;           // the body's frame to the common one
     SpatialHash hash;      // of the triangles
