@@ -92,7 +92,8 @@ Box3f World::sweptBox(Index i, const Vec3& offset, float grow) const {
 // tunnelling from a state without penetration). A vertex more than the gap behind a plane is taken
 // for the far side of a thin part and left alone. Self-contact leaves out the features that share
 // a corner and those within the gap of each other in the rest shape (not all the features around
-// a vertex: where a surface wrinkles under compression, its faces two apart are the ones that cross).
+// a vertex: where a surface wrinkles under compression, its faces two apart are the ones that cross),
+// and on a closed surface the edge pairs without a crease (markCreases).
 void World::detectBodyContacts() {
   bodyContacts_.clear();
   // The bodies that touch something: themselves, or another active body with a surface.
