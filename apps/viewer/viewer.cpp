@@ -571,7 +571,10 @@ void Viewer::trialPanel(const StudyStep& s) {
   ImGui::TextUnformatted(title.c_str());
   if (!task.instructions.empty()) ImGui::TextWrapped("%s", task.instructions.c_str());
   if (failed_) {  // the simulation failed: this trial is not kept
-    if (ImGui::Button("Run the trial again")) prepareStudyStep(false);
+    if (ImGui::Button("Run the trial again")) {
+      failed_ = false;
+      prepareStudyStep(false);
+    }
     return;
   }
   if (!trialStarted_) {
