@@ -70,6 +70,11 @@ struct RunFolder {
 
 using testing::readBytes;
 
+// Participant k's record of the trial in trials/<dir> (position-task-trial).
+nlohmann::json trialJson(const fs::path& data, int k, const std::string& dir) {
+  return nlohmann::json::parse(readBytes(testing::participantFolder(data, k) / "trials" / dir / "trial.json"));
+}
+
 bool anyPartial(const fs::path& dir) {
   for (const auto& e : fs::recursive_directory_iterator(dir))
     if (e.path().filename().string().ends_with(".partial")) return true;
@@ -92,8 +97,7 @@ TEST(StudySimulation, FourParticipantsRunTheStudyInTheirOrders) {
     ASSERT_EQ(who["order"].size(), 2u);
     for (std::size_t pos = 0; pos < 2; ++pos) {
       EXPECT_EQ(who["order"][pos], study.conditions[order[pos]].name) << "P" << k << " position " << pos + 1;
-      const nlohmann::json trial = nlohmann::json::parse(readBytes(testing::participantFolder(data.path, k) / "trials" /
-                                                                   (std::to_string(pos + 1) + "-1-1") / "trial.json"));
+      const nlohmann::json trial = trialJson(data.path, int(k), std::to_string(pos + 1) + "-1-1");
       EXPECT_EQ(trial["condition"], study.conditions[order[pos]].name);
     }
   }
@@ -159,8 +163,7 @@ TEST(StudySimulation, EachConditionRunsWithItsOwnSolverSettings) {
   const std::vector<std::size_t> order = study.orderOf(1);
   for (std::size_t pos = 0; pos < 2; ++pos) {
     const StudyCondition& c = study.conditions[order[pos]];
-    const nlohmann::json trial = nlohmann::json::parse(readBytes(testing::participantFolder(data.path, 1) / "trials" /
-                                                                 (std::to_string(pos + 1) + "-1-1") / "trial.json"));
+    const nlohmann::json trial = trialJson(data.path, 1, std::to_string(pos + 1) + "-1-1");
     EXPECT_EQ(trial["condition"], c.name);
     EXPECT_EQ(trial["iterations"], c.name == "B" ? 2 : loadSceneByName("liver").solver.iterations);
     EXPECT_EQ(trial["substeps"], loadSceneByName("liver").solver.substeps);
@@ -178,8 +181,7 @@ TEST(StudySimulation, ATrialEndsWhenItsTasksEndConditionIsMet) {
   s.dataDir = data.path;
   EXPECT_EQ(runSimulatedParticipant(study, s).trialsRun, 2u);
   for (const char* trialDir : {"1-1-1", "2-1-1"}) {
-    const nlohmann::json trial =
-        nlohmann::json::parse(readBytes(testing::participantFolder(data.path, 1) / "trials" / trialDir / "trial.json"));
+    const nlohmann::json trial = trialJson(data.path, 1, trialDir);
     EXPECT_EQ(trial["ended_by"], "release") << trialDir;
     EXPECT_GE(trial["steps"].get<int>(), 180) << trialDir;  // at least the approach and hold, 3 s
     EXPECT_LE(trial["steps"].get<int>(), 270) << trialDir;  // before the pinch at 4.5 s
