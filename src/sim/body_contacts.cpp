@@ -157,17 +157,17 @@ void World::markCreases(BodyId id) {
   broad.sharp.clear();
   if (!bodyContactSettings_[id].self || b.model->tets.empty()) return;  // every edge of a cloth or between bodies
   const ContactSurface& surface = contactSurfaces_[id];
-  const auto normal = [&](Index t) {
-    const Triangle& tri = b.model->surface[t];
+  broad.normals.clear();  // each face's once, for its three edges
+  for (const Triangle& tri : b.model->surface) {
     const Vec3 &x0 = local_[b.firstParticle + tri[0]].pos, &x1 = local_[b.firstParticle + tri[1]].pos,
                &x2 = local_[b.firstParticle + tri[2]].pos;
-    return (x1 - x0).cross(x2 - x0).normalized();
-  };
+    broad.normals.push_back((x1 - x0).cross(x2 - x0).normalized());
+  }
   constexpr float kCreaseCos = 0.866f;  // faces more than 30 degrees apart
   broad.sharp.resize(surface.edges.size());
   for (std::size_t e = 0; e < surface.edges.size(); ++e) {
     const std::array<Index, 2>& f = surface.edgeFaces[e];
-    broad.sharp[e] = f[1] == ContactSurface::kNoFace || !(normal(f[0]).dot(normal(f[1])) > kCreaseCos);
+    broad.sharp[e] = f[1] == ContactSurface::kNoFace || !(broad.normals[f[0]].dot(broad.normals[f[1]]) > kCreaseCos);
   }
 }
 

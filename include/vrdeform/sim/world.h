@@ -273,7 +273,8 @@ class World {
   struct ContactBroadPhase {
     std::vector<Box3f> boxes;      // per surface triangle
     std::vector<Box3f> edgeBoxes;  // per surface edge
-    std::vector<char> sharp;       // per surface edge of a body in self-contact: a crease (detectBodyContacts)
+    std::vector<char> sharp;       // per surface edge of a body in self-contact: a crease (markCreases)
+    std::vector<Vec3> normals;     // markCreases' scratch: per surface triangle
     Box3f bounds;
     Vec3 offset;           // the body's frame to the common one
     SpatialHash hash;      // of the triangles
