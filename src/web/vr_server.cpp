@@ -318,17 +318,15 @@ class Viewer : public std::enable_shared_from_this<Viewer> {
   void write(Outgoing m) {
     ws_.text(!m.binary);
     held_.clear();
-    std::size_t size = 0;
+    buffers_.clear();
     if (m.binary) {
       held_.push_back(m.binary);
-      size = m.binary->size();
-      startWrite(size);
-      ws_.async_write(net::buffer(*m.binary), beast::bind_front_handler(&Viewer::onWrite, shared_from_this()));
+      buffers_.push_back(net::buffer(*m.binary));
     } else {
       text_ = std::move(m.text);
-      startWrite(text_.size());
-      ws_.async_write(net::buffer(text_), beast::bind_front_handler(&Viewer::onWrite, shared_from_this()));
+      buffers_.push_back(net::buffer(std::as_const(text_)));
     }
+    send(buffers_[0].size());
   }
 
   // The newest frame: the header and the blocks of the bodies that changed since this viewer's
@@ -353,14 +351,15 @@ class Viewer : public std::enable_shared_from_this<Viewer> {
     sentFrame_ = server_.frameNumber;
     server_.counters.framesSent.fetch_add(1, std::memory_order_relaxed);
     ws_.binary(true);
-    startWrite(size);
-    ws_.async_write(buffers_, beast::bind_front_handler(&Viewer::onWrite, shared_from_this()));
+    send(size);
   }
 
-  void startWrite(std::size_t bytes) {
+  // Writes buffers_ (one buffer type for every message, so the write is compiled once).
+  void send(std::size_t bytes) {
     writing_ = true;
     writeStart_ = Clock::now();
     raiseTo(server_.counters.maxInFlightBytes, bytes);
+    ws_.async_write(buffers_, beast::bind_front_handler(&Viewer::onWrite, shared_from_this()));
   }
 
   void onWrite(beast::error_code ec, std::size_t bytes) {
