@@ -16,6 +16,7 @@
 #include <list>
 #include <nlohmann/json.hpp>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "tls_front.h"
