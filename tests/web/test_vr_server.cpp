@@ -194,6 +194,11 @@ TEST(VrServer, ServesThePageAndStatusAndRefusesBadRequests) {
         rawHttp(port, "HEAD /three/build/three.module.js HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
     EXPECT_EQ(three.rfind("HTTP/1.1 200", 0), 0u);
     EXPECT_NE(three.find("text/javascript"), std::string::npos);
+    // The file's length, and nothing after the headers.
+    const std::string whole = get(port, "/three/build/three.module.js");
+    const std::size_t bodyAt = whole.find("\r\n\r\n") + 4;
+    EXPECT_NE(three.find(fmt::format("Content-Length: {}\r\n", whole.size() - bodyAt)), std::string::npos);
+    EXPECT_EQ(three.find("\r\n\r\n") + 4, three.size());
   }
   EXPECT_EQ(status(port)["scene"], "liver");
   const auto code = [](const std::string& r) { return r.substr(0, 12); };
