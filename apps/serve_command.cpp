@@ -25,10 +25,8 @@ namespace vrd {
 namespace {
 
 struct ServeArgs {
-  std::string scene, bind = "127.0.0.1", weart, tlsFolder;
-  bool tls = false;
-  std::uint16_t port = 8080;
-  double frameRate = 72.0;
+  std::string scene, weart;
+  ServeOptions serve;
   double seconds = 0.0;  // 0: until Ctrl-C
 };
 
@@ -48,7 +46,9 @@ std::vector<std::string> lanAddresses() {
   return out;
 }
 
-void printAddresses(const ServeArgs& a, std::uint16_t port) {
+}  // namespace
+
+void printAddresses(const ServeOptions& a, std::uint16_t port) {
   const bool everywhere = a.bind == "0.0.0.0" || a.bind == "::";
   const std::string local = everywhere || a.bind == "127.0.0.1" ? "127.0.0.1" : a.bind;
   const char* scheme = a.tls ? "https" : "http";
@@ -64,19 +64,13 @@ void printAddresses(const ServeArgs& a, std::uint16_t port) {
   std::fflush(stdout);
 }
 
-int serve(const ServeArgs& a) {
-  const SceneSpec spec = loadSceneByName(a.scene);
-  fmt::print("scene {}: {}\n", spec.name, spec.description);
-  std::fflush(stdout);
-  const StopSignals signals;
-  BuiltScene scene = buildScene(spec, commandObserver(signals, false));
+VrServerSettings vrServerSettings(const ServeOptions& a) {
   const std::filesystem::path web = webFolder();
   if (!hasThreeJs(web))
     fmt::print(stderr,
                "vrdeform: warning: {}/node_modules/three is missing (scripts/install-web.sh installs it); "
                "the page cannot draw without it\n",
                web.string());
-
   VrServerSettings vs;
   vs.bind = a.bind;
   vs.port = a.port;
@@ -90,6 +84,32 @@ int serve(const ServeArgs& a) {
         vs.tls->created ? "made a self-signed" : "the self-signed", folder.string(), vs.tls->fingerprint,
         vs.tls->spkiHash);
   }
+  return vs;
+}
+
+void addServeOptions(CLI::App& cmd, ServeOptions& o) {
+  cmd.add_option("--port", o.port, "TCP port of the page and its WebSocket (0: any free one)")->capture_default_str();
+  cmd.add_option("--bind", o.bind,
+                 "Address to listen on; 0.0.0.0 serves the local network (prints the addresses to open)")
+      ->capture_default_str();
+  cmd.add_flag("--tls", o.tls,
+               "Serve HTTPS and WSS (WebXR on the local network needs them) with a self-signed certificate, made "
+               "on first use (its fingerprint printed)");
+  cmd.add_option("--tls-dir", o.tlsFolder, "Where the certificate and key are kept (default: ~/.config/vrdeform/tls)");
+  cmd.add_option("--fps", o.frameRate, "Frames per second sent to the viewers at most")
+      ->check(CLI::Range(1.0, 1000.0))
+      ->capture_default_str();
+}
+
+namespace {
+
+int serve(const ServeArgs& a) {
+  const SceneSpec spec = loadSceneByName(a.scene);
+  fmt::print("scene {}: {}\n", spec.name, spec.description);
+  std::fflush(stdout);
+  const StopSignals signals;
+  BuiltScene scene = buildScene(spec, commandObserver(signals, false));
+  VrServerSettings vs = vrServerSettings(a.serve);
   vs.hand.park = scene.bodies.front().top + Vec3(0.0f, 0.15f, 0.0f);
   const float radius = scene.session.hand.geometry.fingertipRadius;
   std::optional<LiveHandInput> hand;
@@ -106,12 +126,12 @@ int serve(const ServeArgs& a) {
   }
   ls.input = hand ? &*hand : nullptr;
   SimulationLoop loop(scene, ls);
-  VrServer server(loop, scene, web, vs, hand ? &*hand : nullptr);
+  VrServer server(loop, scene, webFolder(), vs, hand ? &*hand : nullptr);
   server.start();
   loop.start();
-  fmt::print("simulating at {:g} Hz, {} frames/s to viewers; the page: {}\n", 1.0 / loop.period(), a.frameRate,
-             (web / "public").string());
-  printAddresses(a, server.port());
+  fmt::print("simulating at {:g} Hz, {} frames/s to viewers; the page: {}\n", 1.0 / loop.period(), a.serve.frameRate,
+             (webFolder() / "public").string());
+  printAddresses(a.serve, server.port());
 
   const auto start = std::chrono::steady_clock::now();
   while (loop.running() && !signals.requested()) {
@@ -147,20 +167,7 @@ std::function<int()> addServeCommand(CLI::App& app) {
   CLI::App* serve = app.add_subcommand(
       "serve", "Run a scene in real time and serve the VR page (WebXR) on which a headset shows and drives it");
   serve->add_option("scene", a->scene, "A built-in scene (`vrdeform scenes`) or a scene file (.toml)")->required();
-  serve->add_option("--port", a->port, "TCP port of the page and its WebSocket (0: any free one)")
-      ->capture_default_str();
-  serve
-      ->add_option("--bind", a->bind,
-                   "Address to listen on; 0.0.0.0 serves the local network (prints the addresses to open)")
-      ->capture_default_str();
-  serve->add_flag("--tls", a->tls,
-                  "Serve HTTPS and WSS (WebXR on the local network needs them) with a self-signed certificate, made "
-                  "on first use (its fingerprint printed)");
-  serve->add_option("--tls-dir", a->tlsFolder,
-                    "Where the certificate and key are kept (default: ~/.config/vrdeform/tls)");
-  serve->add_option("--fps", a->frameRate, "Frames per second sent to the viewers at most")
-      ->check(CLI::Range(1.0, 1000.0))
-      ->capture_default_str();
+  addServeOptions(*serve, a->serve);
   serve->add_option("--seconds", a->seconds, "Stop after this many seconds (default: at Ctrl-C)")
       ->check(CLI::Range(0.0, 1e9));
   serve

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "study_vr.h"
 #include "viewer/viewer.h"
 #include "vrdeform/devices/glove_link.h"
 #include "vrdeform/devices/stop_signals.h"
@@ -24,7 +25,8 @@ struct StudyArgs {
   std::string study, data, out, weart;
   std::size_t participants = 0, participant = 0;
   std::uint64_t seed = 1;
-  bool autopilot = false;
+  bool autopilot = false, vr = false;
+  ServeOptions serve;  // --vr
 };
 
 int check(const StudyArgs& a) {
@@ -103,7 +105,7 @@ int simulate(const StudyArgs& a) {
   return 0;
 }
 
-// A live participant in the desktop viewer, resumed where an earlier run ended.
+// A live participant in the desktop viewer or on the VR page, resumed where an earlier run ended.
 int runLive(const StudyArgs& a) {
   const StudySpec s = loadStudy(a.study);
   ParticipantProgress progress(s, a.data, a.participant, false);
@@ -117,7 +119,8 @@ int runLive(const StudyArgs& a) {
     o.autopilot = a.autopilot;
     o.weart = a.weart;
     try {
-      if (const int status = runViewer(o); status != 0) return status;
+      const int status = a.vr ? runStudyInVr(progress, {a.serve, a.weart, a.autopilot}) : runViewer(o);
+      if (status != 0) return status;
     } catch (const Stopped& e) {  // Ctrl-C while a scene was built
       fmt::print(stderr, "vrdeform: {}\n", e.what());
     }
@@ -158,7 +161,8 @@ std::function<int()> addStudyCommand(CLI::App& app) {
   simulateCmd->add_option("--participant", a->participant, "Participant K alone")->check(CLI::Range(1, 10000));
   simulateCmd->add_option("--seed", a->seed, "Seed of the simulated answers' noise")->capture_default_str();
   CLI::App* runCmd = cmd->add_subcommand(
-      "run", "Walk a participant through the study in the desktop viewer, into DATA/P<K> (resumable)");
+      "run",
+      "Walk a participant through the study in the desktop viewer or on the VR page, into DATA/P<K> (resumable)");
   runCmd->add_option("study", a->study, "The study file (.toml)")->required();
   runCmd->add_option("data", a->data, "The study's data folder")->required();
   runCmd->add_option("--participant", a->participant, "Participant K: their order of the conditions follows from K")
@@ -172,6 +176,11 @@ std::function<int()> addStudyCommand(CLI::App& app) {
   runCmd->add_flag("--autopilot", a->autopilot,
                    "A dry run of the set-up: every step starts by itself, the scenes' scripted hands poke, the "
                    "questions get the scales' middles and rests are skipped");
+  runCmd->add_flag(
+      "--vr", a->vr,
+      "On the VR page instead of the desktop viewer: the headset (or a browser) opens the address printed, "
+      "and the instructions and questions are on a panel there; --port, --bind, --tls and --fps as serve's");
+  addServeOptions(*runCmd, a->serve);
   return [a, checkCmd, analyseCmd, simulateCmd, runCmd]() -> int {
     if (*runCmd) return runLive(*a);
     if (*checkCmd) return check(*a);

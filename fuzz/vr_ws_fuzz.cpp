@@ -51,6 +51,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       require(m.client.size() <= 64);
       (void)json{{"client", m.client}}.dump();  // valid UTF-8, however it was cut
       break;
+    case vr::ClientMessage::Type::Study:
+      require(m.study.ratings.size() <= vr::kMaxStudyItems && m.study.texts.size() <= vr::kMaxStudyItems);
+      for (const std::string& t : m.study.texts) require(t.size() <= vr::kMaxStudyTextBytes);
+      break;
   }
   return 0;
 }

@@ -8,13 +8,12 @@
 namespace vrd {
 
 Questionnaire::Questionnaire(const StudySpec& study, const std::vector<std::size_t>& order, bool final)
-    : study_(study), order_(order), final_(final) {
-  rated_.assign(final ? study.comparisons.size() : study.questions.size(), kUnanswered);
-  for (const StudyFreeText& f : study.freeTexts)
-    if (f.perCondition != final) {
-      texts_.push_back(f.text);
+    : items_(questionnaireItems(study, order, final)) {
+  for (const QuestionnaireItem& item : items_)
+    if (item.rated)
+      rated_.push_back(kUnanswered);
+    else
       buffers_.emplace_back(4096, '\0');
-    }
 }
 
 bool Questionnaire::complete() const {
@@ -22,38 +21,26 @@ bool Questionnaire::complete() const {
 }
 
 bool Questionnaire::draw() {
-  const auto scale = [&](std::size_t i, int lo, int hi, const std::string& left, const std::string& right) {
-    ImGui::PushID(int(i));
-    ImGui::TextDisabled("%s", left.c_str());
-    for (int v = lo; v <= hi; ++v) {
+  std::size_t r = 0, t = 0;
+  for (const QuestionnaireItem& item : items_) {
+    ImGui::TextWrapped("%s", item.text.c_str());
+    if (!item.rated) {
+      std::vector<char>& b = buffers_[t];
+      ImGui::InputTextMultiline(fmt::format("##text{}", t++).c_str(), b.data(), b.size(),
+                                ImVec2(-1.0f, 4.0f * ImGui::GetTextLineHeight()));
+      continue;
+    }
+    ImGui::PushID(int(r));
+    ImGui::TextDisabled("%s", item.lowAnchor.c_str());
+    for (int v = item.low; v <= item.high; ++v) {
       ImGui::SameLine();
-      ImGui::RadioButton(fmt::format("{}##{}", v, v).c_str(), &rated_[i], v);
+      ImGui::RadioButton(fmt::format("{}##{}", v, v).c_str(), &rated_[r], v);
     }
     ImGui::SameLine();
-    ImGui::TextDisabled("%s", right.c_str());
+    ImGui::TextDisabled("%s", item.highAnchor.c_str());
     ImGui::PopID();
     ImGui::Spacing();
-  };
-  if (!final_) {
-    for (std::size_t q = 0; q < study_.questions.size(); ++q) {
-      ImGui::TextWrapped("%s", study_.questions[q].text.c_str());
-      scale(q, 1, study_.points, study_.questions[q].low, study_.questions[q].high);
-    }
-  } else {
-    // A participant knows the conditions by when they met them.
-    const auto part = [&](std::size_t c) {
-      return fmt::format("part {}", std::size_t(std::find(order_.begin(), order_.end(), c) - order_.begin()) + 1);
-    };
-    for (std::size_t d = 0; d < study_.comparisons.size(); ++d) {
-      const StudyComparison& x = study_.comparisons[d];
-      ImGui::TextWrapped("%s", x.text.c_str());
-      scale(d, -study_.comparisonRange, study_.comparisonRange, part(x.a), part(x.b));
-    }
-  }
-  for (std::size_t t = 0; t < texts_.size(); ++t) {
-    ImGui::TextWrapped("%s", texts_[t].c_str());
-    ImGui::InputTextMultiline(fmt::format("##text{}", t).c_str(), buffers_[t].data(), buffers_[t].size(),
-                              ImVec2(-1.0f, 4.0f * ImGui::GetTextLineHeight()));
+    ++r;
   }
   ImGui::BeginDisabled(!complete());
   const bool submitted = ImGui::Button("Submit");
@@ -66,21 +53,20 @@ bool Questionnaire::draw() {
 }
 
 void Questionnaire::answerForDryRun() {
-  const int middle = final_ ? 0 : (study_.points + 1) / 2;
-  std::fill(rated_.begin(), rated_.end(), middle);
-  for (std::vector<char>& b : buffers_) fmt::format_to_n(b.data(), b.size() - 1, "(dry run)");
+  std::vector<std::string> texts;
+  dryRunAnswers(items_, rated_, texts);
+  for (std::size_t t = 0; t < texts.size(); ++t)
+    fmt::format_to_n(buffers_[t].data(), buffers_[t].size() - 1, "{}", texts[t]);
 }
 
-ConditionAnswers Questionnaire::conditionAnswers() const {
-  ConditionAnswers a{rated_, {}};
-  for (const std::vector<char>& b : buffers_) a.freeText.emplace_back(b.data());
-  return a;
+std::vector<std::string> Questionnaire::texts() const {
+  std::vector<std::string> out;
+  for (const std::vector<char>& b : buffers_) out.emplace_back(b.data());
+  return out;
 }
 
-FinalAnswers Questionnaire::finalAnswers() const {
-  FinalAnswers a{rated_, {}};
-  for (const std::vector<char>& b : buffers_) a.freeText.emplace_back(b.data());
-  return a;
-}
+ConditionAnswers Questionnaire::conditionAnswers() const { return {rated_, texts()}; }
+
+FinalAnswers Questionnaire::finalAnswers() const { return {rated_, texts()}; }
 
 }  // namespace vrd

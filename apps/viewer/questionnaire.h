@@ -1,19 +1,19 @@
 #pragma once
-// A study's questionnaire in the desktop viewer (`vrdeform study run`, docs/study.md): the Likert
-// items and free-text items after a condition, or the direct comparisons and free-text items after
-// all of them, drawn with Dear ImGui; Submit is offered once every rated item has an answer.
+// A study's questionnaire in the desktop viewer (`vrdeform study run`, docs/study.md): the items
+// (study/questionnaire_items.h) drawn with Dear ImGui; Submit is offered once every rated item has
+// an answer.
 
 #include <string>
 #include <vector>
 
-#include "vrdeform/study/participant_progress.h"
+#include "vrdeform/study/questionnaire_items.h"
 
 namespace vrd {
 
 class Questionnaire {
  public:
   /// After a condition (`final` false) or after all of them; `order` is the participant's order of
-  /// the conditions, so that a comparison names them as met ("part 1", "part 2"), not by name.
+  /// the conditions.
   Questionnaire(const StudySpec& study, const std::vector<std::size_t>& order, bool final);
 
   /// Draws the items in the current ImGui window; true when Submit is pressed.
@@ -26,13 +26,11 @@ class Questionnaire {
  private:
   static constexpr int kUnanswered = -1000;
   bool complete() const;
+  std::vector<std::string> texts() const;
 
-  const StudySpec& study_;
-  std::vector<std::size_t> order_;
-  bool final_;
-  std::vector<int> rated_;                  // per Likert item or comparison
-  std::vector<std::string> texts_;          // the free-text items asked now, their text
-  std::vector<std::vector<char>> buffers_;  // their edit buffers
+  std::vector<QuestionnaireItem> items_;
+  std::vector<int> rated_;                  // per rated item
+  std::vector<std::vector<char>> buffers_;  // per free-text item, its edit buffer
 };
 
 }  // namespace vrd

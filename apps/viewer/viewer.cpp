@@ -20,15 +20,11 @@
 #include <optional>
 #include <vector>
 
-#include "vrdeform/core/write_file.h"
-#include "vrdeform/devices/csv_recorder.h"
 #include "vrdeform/devices/glove_link.h"
 #include "vrdeform/devices/haptic_output.h"
-#include "vrdeform/devices/osc_output.h"
 #include "vrdeform/devices/stop_signals.h"
 #include "vrdeform/error.h"
 #include "vrdeform/interact/live_hand_input.h"
-#include "vrdeform/metrics/latency_stats.h"
 #include "vrdeform/render/gl_driver.h"
 #include "vrdeform/render/image.h"
 #include "vrdeform/render/mouse_hand.h"
@@ -37,7 +33,7 @@
 #include "vrdeform/scene/simulation_loop.h"
 #include "vrdeform/study/participant_progress.h"
 #include "vrdeform/study/task_end.h"
-#include "vrdeform/study/trial_events.h"
+#include "vrdeform/study/trial_outputs.h"
 
 namespace vrd {
 namespace {
@@ -50,10 +46,7 @@ struct Running {
   BuiltScene scene;
   LiveHandInput mouseInput;
   std::optional<GloveLink> glove;
-  std::optional<OscOutput> osc;                   // a study's condition on an OSC device
-  std::optional<BaselineAsForce> baselineDevice;  // a study's condition B: the device gets the baseline
-  std::optional<CsvRecorder> recorder;            // a study's trial: its signal, forces.csv
-  std::optional<TrialEvents> events;              // and its task events
+  std::optional<TrialOutputs> trial;  // a study's trial: its device, its signal and task events recorded
   std::unique_ptr<SimulationLoop> loop;
   std::shared_ptr<SnapshotChannel> channel;
   Snapshot settled;  // the world before the first step: drawn until the first snapshot arrives
@@ -77,14 +70,12 @@ struct Running {
 
 // How a built scene's loop runs: the viewer's defaults, or a study's trial.
 struct LoopOptions {
-  std::string weart;                        // HOST[:PORT] of the WEART middleware; empty: the mouse is the hand
-  bool paused = false;                      // the loop starts paused
-  bool scripted = false;                    // the scene's scripted hand drives it (a study's dry run)
-  bool baseline = false;                    // the device gets the condition B baseline
-  StudyDevice device = StudyDevice::Glove;  // where the force goes (a study's condition)
-  std::string osc;                          // HOST:PORT of an OSC device
-  std::uint64_t maxSteps = 0;               // 0: until stopped
-  std::filesystem::path forces;             // the signal recorded here (CSV), the task events beside it
+  std::string weart;                          // HOST[:PORT] of the WEART middleware; empty: the mouse is the hand
+  bool paused = false;                        // the loop starts paused
+  bool scripted = false;                      // the scene's scripted hand drives it (a study's dry run)
+  const StudyCondition* condition = nullptr;  // a study's trial in this condition, its signal recorded:
+  std::filesystem::path forces;               // here (CSV), the task events beside it
+  std::uint64_t maxSteps = 0;                 // 0: until stopped
 };
 
 std::unique_ptr<Running> start(const SceneSpec& spec, const SceneBuildObserver& observer, const LoopOptions& o) {
@@ -98,17 +89,12 @@ std::unique_ptr<Running> start(const SceneSpec& spec, const SceneBuildObserver& 
     r->glove.emplace(o.weart, r->scene.session.hand, point);
     settings.input = &r->glove->input();
   }
-  HapticOutput* device = o.device == StudyDevice::Glove && r->glove ? &r->glove->output() : nullptr;
-  if (o.device == StudyDevice::Osc) {
-    const HostPort to = parseHostPort(o.osc);
-    device = &r->osc.emplace(to.host, to.port);
-  }
-  if (device) settings.outputs.push_back(o.baseline ? &r->baselineDevice.emplace(*device) : device);
+  HapticOutput* glove = r->glove ? &r->glove->output() : nullptr;
+  if (o.condition)
+    r->trial.emplace(settings, r->scene, *o.condition, glove, o.forces);
+  else if (glove)
+    settings.outputs.push_back(glove);
   if (o.scripted) settings.input = nullptr;
-  if (!o.forces.empty()) {
-    settings.outputs.push_back(&r->recorder.emplace(o.forces, r->scene.session.hand.fingers));
-    settings.outputs.push_back(&r->events.emplace());
-  }
   captureSnapshot(r->settled, *r->scene.world, nullptr, 0, 0.0);
   captureConstraintForces(r->settled, *r->scene.world);
   r->posed.pose(r->settled, ColorMap::None);
@@ -520,9 +506,7 @@ void Viewer::prepareStudyStep(bool first) {
     spec_ = c.spec;
     loop_.maxSteps = std::uint64_t(std::max(std::lround(seconds / spec_.solver.timeStep), 1L));
     loop_.forces = p.beginTrial() / "forces.csv";
-    loop_.baseline = c.force == StudyForce::Baseline;
-    loop_.device = c.device;
-    loop_.osc = c.osc;
+    loop_.condition = &c;
     taskEnd_.emplace(p.task(s).end);
     endConditionMet_ = false;
     loop_.scripted = options_.autopilot;
@@ -600,14 +584,8 @@ void Viewer::startTrial() {
 // The trial's loop ran its steps (run() stopped it): its record, and the next step.
 void Viewer::finishTrial() {
   Running& r = *running_;
-  r.recorder->flush();
-  if (r.recorder->failed())
-    throw Error(
-        fmt::format("{}: the trial's signal was not recorded: {}", r.recorder->path().string(), r.recorder->error()));
+  r.trial->finish(*r.loop);
   const double wall = std::chrono::duration<double>(Clock::now() - trialBegan_).count();
-  const std::filesystem::path dir = r.recorder->path().parent_path();
-  writeFile(dir / "events.csv", r.events->csv());
-  writeFile(dir / "latency.csv", latencyCsv(r.loop->latency()));
   options_.study->finishTrial({r.loop->stats().steps, wall, std::nullopt, endConditionMet_});
   prepareStudyStep(false);
 }

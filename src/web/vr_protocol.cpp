@@ -112,6 +112,46 @@ XrInput input(const json& m) {
   return in;
 }
 
+StudyReply studyReply(const json& m) {
+  StudyReply r;
+  const auto panel = m.find("panel");
+  if (panel == m.end() || !panel->is_number_unsigned()) bad("panel: expected the panel's id");
+  r.panel = panel->get<std::uint64_t>();
+  const auto action = m.find("action");
+  if (action == m.end() || !action->is_string()) bad("action: expected a string");
+  const std::string& a = action->get_ref<const std::string&>();
+  if (a == "start")
+    r.action = StudyReply::Action::Start;
+  else if (a == "continue")
+    r.action = StudyReply::Action::Continue;
+  else if (a == "submit")
+    r.action = StudyReply::Action::Submit;
+  else if (a == "retry")
+    r.action = StudyReply::Action::Retry;
+  else
+    bad(fmt::format("action: unknown action '{}'", excerpt(a, 32)));
+  const auto list = [&](const char* key) -> const json* {
+    const auto it = m.find(key);
+    if (it == m.end()) return nullptr;
+    if (!it->is_array() || it->size() > kMaxStudyItems)
+      bad(fmt::format("{}: expected an array of at most {}", key, kMaxStudyItems));
+    return &*it;
+  };
+  if (const json* ratings = list("ratings"))
+    for (const json& v : *ratings) {
+      if (!v.is_number_integer() || std::abs(v.get<std::int64_t>()) > 100)
+        bad("ratings: expected integers in -100..100");
+      r.ratings.push_back(v.get<int>());
+    }
+  if (const json* texts = list("texts"))
+    for (const json& v : *texts) {
+      if (!v.is_string() || v.get_ref<const std::string&>().size() > kMaxStudyTextBytes)
+        bad(fmt::format("texts: expected strings of at most {} bytes", kMaxStudyTextBytes));
+      r.texts.push_back(v.get<std::string>());
+    }
+  return r;
+}
+
 }  // namespace
 
 ClientMessage parseClientMessage(std::string_view text) {
@@ -137,6 +177,9 @@ ClientMessage parseClientMessage(std::string_view text) {
       if (!client->is_string()) bad("client: expected a string");
       out.client = std::string(excerpt(client->get_ref<const std::string&>(), 64));
     }
+  } else if (t == "study") {
+    out.type = ClientMessage::Type::Study;
+    out.study = studyReply(m);
   } else {
     bad(fmt::format("unknown message type '{}'", excerpt(t, 32)));
   }

@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstdio>
 #include <deque>
+#include <future>
 #include <list>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -96,6 +97,7 @@ struct Server {
   Server(SimulationLoop& loop, const BuiltScene& scene, std::filesystem::path web, VrServerSettings settings,
          LiveHandInput* hand);
 
+  void present(SimulationLoop& loop, const BuiltScene& scene, LiveHandInput* hand, const Snapshot& first);
   void run();
   void tick();
   void takeSnapshot(const Snapshot& s);
@@ -105,12 +107,13 @@ struct Server {
   std::string statusJson() const;
   void shutdown();
 
-  SimulationLoop& loop;
-  const BuiltScene& scene;
   std::filesystem::path web;
   VrServerSettings settings;
-  LiveHandInput* hand;
-  float radius;
+  // The scene shown (present()).
+  SimulationLoop* loop = nullptr;
+  const BuiltScene* scene = nullptr;
+  LiveHandInput* hand = nullptr;
+  float radius = 0.0f;
   std::vector<ViewMesh> meshes;
   std::shared_ptr<SnapshotChannel> channel;
 
@@ -127,6 +130,7 @@ struct Server {
   Snapshot latest;                // the fields status.json reports (positions left empty)
   std::shared_ptr<const std::string> sceneJson;
   std::shared_ptr<const Bytes> topology;
+  std::shared_ptr<const std::string> panel;  // a study's panel; null: none
   Clock::time_point lastInput{};
   bool driven = false;
   std::optional<XrPose> head;
@@ -236,10 +240,31 @@ class Viewer : public std::enable_shared_from_this<Viewer> {
     server_.counters.viewers.fetch_add(1, std::memory_order_relaxed);
     server_.counters.viewersTotal.fetch_add(1, std::memory_order_relaxed);
     server_.logLimited(fmt::format("vr: viewer {} connected from {}", id_, peer_));
-    control_.push_back({nullptr, *server_.sceneJson});
-    control_.push_back({server_.topology, {}});
+    greet();
     pump();
     read();
+  }
+
+ public:
+  // The scene shown changed: its scene message and topology, then frames of every body.
+  void reshow() {
+    if (!accepted_ || closing_) return;
+    sentVersion_.assign(server_.bodies.size(), 0);
+    greet();
+    pump();
+  }
+
+  void showPanel() {
+    if (!accepted_ || closing_ || !server_.panel) return;
+    control_.push_back({nullptr, *server_.panel});
+    pump();
+  }
+
+ private:
+  void greet() {
+    control_.push_back({nullptr, *server_.sceneJson});
+    control_.push_back({server_.topology, {}});
+    if (server_.panel) control_.push_back({nullptr, *server_.panel});
   }
 
   void read() { ws_.async_read(in_, beast::bind_front_handler(&Viewer::onRead, shared_from_this())); }
@@ -286,6 +311,10 @@ class Viewer : public std::enable_shared_from_this<Viewer> {
         break;
       case vr::ClientMessage::Type::Ping:
         reply(json{{"type", "pong"}, {"t", m.pingTime}, {"step", server_.latest.step}}.dump());
+        break;
+      case vr::ClientMessage::Type::Study:
+        if (!server_.settings.onStudy) return strike("a study message, but no study is running", true);
+        server_.settings.onStudy(m.study);
         break;
       case vr::ClientMessage::Type::Hello:
         if (!greeted_)
@@ -538,19 +567,38 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 
 // --- The server ----------------------------------------------------------------------------------------
 
+// The world as it is before the loop's first step: the first frame of a scene shown.
+Snapshot firstSnapshot(const BuiltScene& scene) {
+  Snapshot s;
+  captureSnapshot(s, *scene.world, nullptr, 0, 0.0);
+  return s;
+}
+
 Server::Server(SimulationLoop& loop_, const BuiltScene& scene_, std::filesystem::path web_, VrServerSettings settings_,
                LiveHandInput* hand_)
-    : loop(loop_), scene(scene_), web(std::move(web_)), settings(std::move(settings_)), hand(hand_) {
+    : web(std::move(web_)), settings(std::move(settings_)) {
   if (!(settings.frameRate >= 1.0 && settings.frameRate <= 1000.0))
     throw Error(fmt::format("vr server: frame rate {} is outside [1, 1000]", settings.frameRate));
   if (settings.maxMessageBytes < 1024) throw Error("vr server: maxMessageBytes must be at least 1024");
-  radius = scene.session.hand.geometry.fingertipRadius;
-  meshes = viewMeshes(scene);
-  bodies.resize(meshes.size());
+  present(loop_, scene_, hand_, firstSnapshot(scene_));
+}
+
+void Server::present(SimulationLoop& loop_, const BuiltScene& scene_, LiveHandInput* hand_, const Snapshot& first) {
+  std::vector<ViewMesh> shown = viewMeshes(scene_);
+  auto message = std::make_shared<const std::string>(vr::sceneMessage(scene_, shown, settings.frameRate));
+  auto topo = std::make_shared<const Bytes>(vr::encodeTopology(shown));
+  loop = &loop_;
+  scene = &scene_;
+  hand = hand_;
+  driven = false;
+  radius = scene->session.hand.geometry.fingertipRadius;
+  meshes = std::move(shown);
+  bodies.assign(meshes.size(), {});
   for (std::size_t b = 0; b < meshes.size(); ++b) bodies[b].positions.resize(meshes[b].vertexCount());
-  sceneJson = std::make_shared<const std::string>(vr::sceneMessage(scene, meshes, settings.frameRate));
-  topology = std::make_shared<const Bytes>(vr::encodeTopology(meshes));
-  channel = loop.subscribe();
+  sceneJson = std::move(message);
+  topology = std::move(topo);
+  channel = loop->subscribe();
+  takeSnapshot(first);
 }
 
 void Server::log(std::string_view line) const {
@@ -655,7 +703,7 @@ std::string Server::statusJson() const {
                            : json(nullptr));
   }
   const auto c = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
-  json j = {{"scene", scene.spec.name},
+  json j = {{"scene", scene->spec.name},
             {"step", latest.step},
             {"time", latest.time},
             {"frame", frameNumber},
@@ -769,6 +817,42 @@ void VrServer::stop() {
   s.ioc.reset();  // destroys the handlers still pending, and with them the sessions
   s.viewers.clear();
   s.httpSessions.clear();
+}
+
+void VrServer::show(SimulationLoop& loop, const BuiltScene& scene, LiveHandInput* hand, const Vec3& park) {
+  Impl& s = *impl_;
+  const Snapshot first = firstSnapshot(scene);
+  if (!s.thread.joinable() || s.ioDone.load()) {
+    s.settings.hand.park = park;
+    return s.present(loop, scene, hand, first);
+  }
+  std::promise<void> done;
+  net::post(*s.ioc, [&] {
+    try {
+      s.settings.hand.park = park;
+      s.present(loop, scene, hand, first);
+      for (const std::weak_ptr<Viewer>& w : s.viewers)
+        if (const auto v = w.lock()) v->reshow();
+      done.set_value();
+    } catch (...) {
+      done.set_exception(std::current_exception());
+    }
+  });
+  done.get_future().get();
+}
+
+void VrServer::setPanel(std::string json) {
+  Impl& s = *impl_;
+  auto panel = json.empty() ? nullptr : std::make_shared<const std::string>(std::move(json));
+  if (!s.thread.joinable() || s.ioDone.load()) {
+    s.panel = std::move(panel);
+    return;
+  }
+  net::post(*s.ioc, [&s, panel = std::move(panel)] {
+    s.panel = panel;
+    for (const std::weak_ptr<Viewer>& w : s.viewers)
+      if (const auto v = w.lock()) v->showPanel();
+  });
 }
 
 std::uint16_t VrServer::port() const { return impl_->port.load(); }

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "test_support.h"
 #include "vrdeform/web/static_files.h"
@@ -133,6 +134,40 @@ TEST(VrProtocol, InputMessages) {
   EXPECT_EQ(vr::parseClientMessage(R"({"type":"input","head":null,"hand":null})").input.source, XrSource::None);
   EXPECT_EQ(vr::parseClientMessage(R"({"type":"ping","t":123.5})").pingTime, 123.5);
   EXPECT_EQ(vr::parseClientMessage(R"({"type":"hello","client":"page"})").client, "page");
+}
+
+TEST(VrProtocol, StudyReplies) {
+  const auto m = vr::parseClientMessage(
+      R"({"type":"study","panel":12,"action":"submit","ratings":[7,-3,1],"texts":["fine","a, \"quoted\"\nline"]})");
+  ASSERT_EQ(m.type, vr::ClientMessage::Type::Study);
+  EXPECT_EQ(m.study.panel, 12u);
+  EXPECT_EQ(m.study.action, vr::StudyReply::Action::Submit);
+  EXPECT_EQ(m.study.ratings, (std::vector<int>{7, -3, 1}));
+  EXPECT_EQ(m.study.texts, (std::vector<std::string>{"fine", "a, \"quoted\"\nline"}));
+  const auto start = vr::parseClientMessage(R"({"type":"study","panel":1,"action":"start"})");
+  EXPECT_EQ(start.study.action, vr::StudyReply::Action::Start);
+  EXPECT_TRUE(start.study.ratings.empty());
+  EXPECT_EQ(vr::parseClientMessage(R"({"type":"study","panel":2,"action":"continue"})").study.action,
+            vr::StudyReply::Action::Continue);
+  EXPECT_EQ(vr::parseClientMessage(R"({"type":"study","panel":2,"action":"retry"})").study.action,
+            vr::StudyReply::Action::Retry);
+
+  using testing::errorOf;
+  const auto reason = [](const std::string& text) { return errorOf([&] { vr::parseClientMessage(text); }); };
+  EXPECT_EQ(reason(R"({"type":"study","action":"start"})"), "panel: expected the panel's id");
+  EXPECT_EQ(reason(R"({"type":"study","panel":-1,"action":"start"})"), "panel: expected the panel's id");
+  EXPECT_EQ(reason(R"({"type":"study","panel":1})"), "action: expected a string");
+  EXPECT_EQ(reason(R"({"type":"study","panel":1,"action":"skip"})"), "action: unknown action 'skip'");
+  EXPECT_EQ(reason(R"({"type":"study","panel":1,"action":"submit","ratings":[1.5]})"),
+            "ratings: expected integers in -100..100");
+  EXPECT_EQ(reason(R"({"type":"study","panel":1,"action":"submit","ratings":[1000]})"),
+            "ratings: expected integers in -100..100");
+  EXPECT_EQ(reason(R"({"type":"study","panel":1,"action":"submit","ratings":{}})"),
+            "ratings: expected an array of at most 256");
+  EXPECT_EQ(reason(R"({"type":"study","panel":1,"action":"submit","texts":[3]})"),
+            "texts: expected strings of at most 4000 bytes");
+  EXPECT_EQ(reason(R"({"type":"study","panel":1,"action":"submit","texts":[")" + std::string(4001, 'x') + R"("]})"),
+            "texts: expected strings of at most 4000 bytes");
 }
 
 TEST(VrProtocol, RefusesBadMessagesWithAReason) {

@@ -53,8 +53,8 @@ using namespace std::chrono_literals;
 // behaviour does not depend on the physics, and the tests stay quick under the sanitizers. Without
 // gravity it lies perfectly still (warm-started, its multipliers carry float rounding from substep
 // to substep, and it trembles by an ulp).
-BuiltScene liver(bool gravity = true) {
-  SceneSpec spec = loadSceneByName("liver");
+BuiltScene liver(bool gravity = true, const std::string& name = "liver") {
+  SceneSpec spec = loadSceneByName(name);
   spec.solver.timeStep = float(1.0 / 120.0);
   spec.settle = 0.0;
   spec.haptics.calibrate = false;
@@ -263,6 +263,72 @@ TEST(VrServer, ViewersGetTheSceneTopologyThenFramesOfChangedBodiesOnly) {
   const json pong = b.nextJson();
   EXPECT_EQ(pong["type"], "pong");
   EXPECT_EQ(pong["t"], 7);
+  // No study runs here: a study reply is refused with the reason.
+  b.send(R"({"type":"study","panel":1,"action":"start"})");
+  EXPECT_EQ(b.nextJson()["reason"], "a study message, but no study is running");
+}
+
+// `study run --vr`: the server shows one scene after another and a study's panel; every viewer
+// gets the new scene, its topology and the panel, and the participants' replies are passed on.
+TEST(VrServer, ShowsAnotherSceneAndAStudyPanelAndPassesOnTheReplies) {
+  std::mutex repliesMutex;
+  std::vector<vr::StudyReply> replies;
+  VrServerSettings settings;
+  settings.onStudy = [&](const vr::StudyReply& r) {
+    std::lock_guard lock(repliesMutex);
+    replies.push_back(r);
+  };
+  Served s(settings, /*gravity=*/false);
+  Client a(s.server->port());
+  EXPECT_EQ(a.nextJson()["name"], "liver");
+  s.server->setPanel(R"({"type":"study","id":1,"step":"trial"})");
+  EXPECT_EQ(a.nextJson()["id"], 1);
+  a.send(R"({"type":"study","panel":1,"action":"submit","ratings":[4,-2],"texts":["ok"]})");
+  ASSERT_TRUE(eventually([&] {
+    std::lock_guard lock(repliesMutex);
+    return !replies.empty();
+  }));
+  {
+    std::lock_guard lock(repliesMutex);
+    EXPECT_EQ(replies[0].panel, 1u);
+    EXPECT_EQ(replies[0].action, vr::StudyReply::Action::Submit);
+    EXPECT_EQ(replies[0].ratings, (std::vector<int>{4, -2}));
+    EXPECT_EQ(replies[0].texts, (std::vector<std::string>{"ok"}));
+  }
+
+  // Another scene, its loop not started: its first frame is the world as built.
+  BuiltScene flag = liver(false, "flag");
+  LiveHandInput hand;
+  SimulationLoopSettings ls;
+  ls.input = &hand;
+  SimulationLoop loop(flag, ls);
+  const Vec3 park = flag.bodies.front().top + Vec3(0.0f, 0.2f, 0.0f);
+  s.server->show(loop, flag, &hand, park);
+  s.loop->stop();  // the liver's loop may go now
+  const std::vector<ViewMesh> meshes = viewMeshes(flag);
+  json m;
+  do m = a.nextJson();
+  while (m["type"] != "scene");
+  EXPECT_EQ(m["name"], "flag");
+  bool text = true;
+  const std::string topology = a.next(&text);
+  ASSERT_FALSE(text);
+  EXPECT_EQ(read<std::uint32_t>(topology, 12), meshes[0].vertexCount());
+  EXPECT_EQ(a.nextJson()["id"], 1);  // the panel again, after the scene
+  const std::string first = a.next(&text);
+  ASSERT_FALSE(text);
+  ASSERT_EQ(read<std::uint32_t>(first, vr::frame::kBlocks), 1u);
+  EXPECT_EQ(read<std::uint32_t>(first, vr::frame::kHeaderBytes + 4), meshes[0].vertexCount());
+  EXPECT_EQ(read<std::uint64_t>(first, vr::frame::kStep), 0u);
+  // A viewer that comes later gets the flag and the panel.
+  Client b(s.server->port());
+  EXPECT_EQ(b.nextJson()["name"], "flag");
+  b.next();
+  EXPECT_EQ(b.nextJson()["step"], "trial");
+  EXPECT_EQ(status(s.server->port())["scene"], "flag");
+  a.ws.next_layer().close();  // gone: the server stops without waiting for their close handshakes
+  b.ws.next_layer().close();
+  s.server->stop();  // before the flag and its loop go
 }
 
 TEST(VrServer, AViewersControllerDrivesTheHandUntilItGoesQuiet) {

@@ -6,11 +6,15 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { VRButton } from 'three/addons/webxr/VRButton.js';
 import * as wire from './protocol.js';
+import { createStudyPanel } from './study.js';
 
 // Where the first body's top is placed in VR, from the head at the session's first frame: 30 cm
-// below it and 40 cm ahead (horizontally), on a table in front of the user, standing or seated.
+// below it and 40 cm ahead (horizontally), on a table in front of the user, standing or seated. A
+// study's board stands behind it, a little below the eyes, facing the head.
 const BELOW_HEAD = 0.3;
 const AHEAD_OF_HEAD = 0.4;
+const BOARD_AHEAD = 0.6;
+const BOARD_BELOW_HEAD = 0.05;
 const BODY_COLOURS = [0xb8432f, 0xd9a441, 0x6a8fd0, 0x8fbf5a, 0xa070c0];
 const TIP_COLOUR = new THREE.Color(0x4fc3f7);
 const PRESS_COLOUR = new THREE.Color(0xff9800);
@@ -23,6 +27,8 @@ const state = {
   framesReceived: 0,
   blocksApplied: 0,
   step: 0,
+  time: 0,
+  study: null, // the study's panel message (`vrdeform study run --vr`), else null
   force: [0, 0, 0, 0, 0],
   newtons: [0, 0, 0, 0, 0],
   grasping: false,
@@ -73,6 +79,19 @@ let bodies = []; // per body: {mesh, positions (Float32Array), dirty}
 let tips = []; // one sphere per finger (hidden for fingers the hand lacks)
 const panel = makePanel();
 root.add(panel.mesh);
+const study = createStudyPanel((m) => socket && socket.readyState === WebSocket.OPEN && socket.send(JSON.stringify(m)));
+scene.add(study.mesh);
+// The controllers' rays, shown while the study's board waits for a press.
+const rays = [0, 1].map((i) => {
+  const controller = renderer.xr.getController(i);
+  const line = new THREE.Line(
+    new THREE.BufferGeometry().setFromPoints([new THREE.Vector3(0, 0, 0), new THREE.Vector3(0, 0, -1.5)]),
+    new THREE.LineBasicMaterial({ color: 0x4fc3f7 }),
+  );
+  controller.add(line);
+  scene.add(controller);
+  return line;
+});
 
 function makePanel() {
   const canvas = document.createElement('canvas');
@@ -187,6 +206,10 @@ function placeInXr(frame) {
   const table = head.addScaledVector(ahead, AHEAD_OF_HEAD).add(new THREE.Vector3(0, -BELOW_HEAD, 0));
   root.position.copy(table).sub(new THREE.Vector3(...first.top));
   root.updateMatrixWorld(true);
+  const eye = new THREE.Vector3().copy(viewer.transform.position);
+  study.mesh.position.copy(eye).addScaledVector(ahead, BOARD_AHEAD).add(new THREE.Vector3(0, -BOARD_BELOW_HEAD, 0));
+  study.mesh.lookAt(eye);
+  study.mesh.updateMatrixWorld(true);
   placedInXr = true;
 }
 
@@ -208,6 +231,7 @@ function applyFrame(buffer) {
   });
   state.framesReceived++;
   state.step = frame.step;
+  state.time = frame.time;
   state.force = frame.force;
   state.newtons = frame.newtons;
   state.grasping = frame.grasping;
@@ -298,6 +322,7 @@ function connect() {
       if (typeof event.data === 'string') {
         const m = JSON.parse(event.data);
         if (m.type === 'scene') pendingScene = m;
+        else if (m.type === 'study') study.show((state.study = m));
         else if (m.type === 'error') state.lastError = m.reason;
         return;
       }
@@ -385,8 +410,18 @@ function pulse(source) {
   state.pulses++;
 }
 
+// A select (trigger or pinch) presses the study board's button its target ray points at.
+function onSelect(event) {
+  const pose = event.frame.getPose(event.inputSource.targetRaySpace, renderer.xr.getReferenceSpace());
+  if (!pose) return;
+  const o = pose.transform.orientation;
+  const direction = new THREE.Vector3(0, 0, -1).applyQuaternion(new THREE.Quaternion(o.x, o.y, o.z, o.w));
+  study.select(new THREE.Ray(new THREE.Vector3().copy(pose.transform.position), direction));
+}
+
 renderer.xr.addEventListener('sessionstart', () => {
   state.xrPresenting = true;
+  renderer.xr.getSession().addEventListener('select', onSelect);
   placeRoot();
 });
 renderer.xr.addEventListener('sessionend', () => {
@@ -419,6 +454,8 @@ renderer.setAnimationLoop((time, frame) => {
     pokeStep();
   }
   drawPanel();
+  study.update(renderer.xr.isPresenting, state.time);
+  for (const ray of rays) ray.visible = study.mesh.visible;
   renderer.render(scene, camera);
   if (window.vrdeform.afterRender) window.vrdeform.afterRender(renderer.getContext(), renderer.xr.isPresenting);
 });
@@ -437,4 +474,15 @@ window.vrdeform = {
     return [rect.left + ((v.x + 1) / 2) * rect.width, rect.top + ((1 - v.y) / 2) * rect.height];
   },
   panelCentre: () => panel.mesh.position.toArray(),
+  study: study.panel,
+  // A pose 30 cm in front of a study board's button, its target ray (-z) on it: {position, quaternion}.
+  aimAtButton: (action, item, value) => {
+    const at = study.buttonCentre(action, item, value);
+    if (!at) return null;
+    const target = new THREE.Vector3(...at);
+    const normal = new THREE.Vector3(0, 0, 1).applyQuaternion(study.mesh.getWorldQuaternion(new THREE.Quaternion()));
+    const eye = target.clone().addScaledVector(normal, 0.3);
+    const q = new THREE.Quaternion().setFromRotationMatrix(new THREE.Matrix4().lookAt(eye, target, new THREE.Vector3(0, 1, 0)));
+    return { position: eye.toArray(), quaternion: q.toArray() };
+  },
 };

@@ -6,7 +6,7 @@
 // (the server reports a grasp). Usage: node vr.test.mjs [VRDEFORM] (or $VRDEFORM).
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
-import { mkdtempSync, rmSync } from 'node:fs';
+import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { test } from 'node:test';
@@ -39,8 +39,9 @@ async function until(what, check, timeoutMs = 10000) {
   throw new Error(`timed out after ${timeoutMs} ms waiting for ${what}`);
 }
 
-function startServer(extra = []) {
-  const server = spawn(vrdeform, ['serve', 'liver', '--port', '0', ...extra], { stdio: ['ignore', 'pipe', 'pipe'] });
+// `vrdeform COMMAND --port 0 EXTRA...` (default: serve liver), and the address it serves on.
+function startServer(extra = [], command = ['serve', 'liver']) {
+  const server = spawn(vrdeform, [...command, '--port', '0', ...extra], { stdio: ['ignore', 'pipe', 'pipe'] });
   let output = '';
   const exited = new Promise((resolve) => server.on('exit', (code, signal) => resolve({ code, signal })));
   const url = new Promise((resolve, reject) => {
@@ -282,4 +283,134 @@ test('the desktop page: the force panel in view, poking with the mouse', { timeo
   await until('the force to go once released', async () => (await status()).force[1] < 0.01);
   assert.deepEqual(errors, [], `page errors: ${errors.join('\n')}`);
   await stop();
+});
+
+// `vrdeform study run --vr`: participant 1 of a two-condition study walked through it in the
+// emulated headset: each trial's Start, the questionnaire after each condition, the rest's
+// Continue and the final comparison pressed on the study board with the controller's ray (trigger);
+// then the answers in the participant's folder are the ones pressed.
+test('a study on the VR page: trials, questionnaires and a rest answered with the controller', { timeout: 170000 }, async (t) => {
+  const work = mkdtempSync(path.join(tmpdir(), 'vrdeform-study-'));
+  t.after(() => rmSync(work, { recursive: true, force: true }));
+  const studyFile = path.join(work, 'study.toml');
+  writeFileSync(
+    studyFile,
+    `format = 1
+name = "vr page"
+trials = 1
+rest = 1.0
+points = 5
+[[condition]]
+name = "A"
+scene = "liver"
+[[condition]]
+name = "B"
+scene = "liver"
+force = "baseline"
+[[task]]
+name = "poke"
+instructions = "Press the liver."
+seconds = 0.5
+[[question]]
+id = "H1"
+dimension = "haptic"
+text = "The force grew as I pressed."
+[[question]]
+id = "V1"
+dimension = "visual"
+text = "The liver looked soft."
+[[comparison]]
+id = "D1"
+text = "Which felt more real?"
+[[free_text]]
+id = "F1"
+text = "Anything else?"
+after = "study"
+`,
+  );
+  const data = path.join(work, 'data');
+  const { server, url, exited, output } = startServer([], ['study', 'run', studyFile, data, '--participant', '1', '--vr']);
+  const profile = mkdtempSync(path.join(tmpdir(), 'vrdeform-chromium-'));
+  let browser;
+  t.after(async () => {
+    if (browser) await browser.close().catch(() => {});
+    if (server.exitCode === null) server.kill('SIGKILL');
+    rmSync(profile, { recursive: true, force: true });
+  });
+  const base = await url;
+  browser = await openHeadset(profile);
+  const { page, errors } = await headsetPage(browser);
+  await page.goto(base);
+  await until('the study panel', () => page.evaluate(() => vrdeform.state.study && vrdeform.state.framesReceived > 0), 30000);
+  await page.click('#VRButton');
+  await until('an immersive-vr session', () => page.evaluate(() => vrdeform.state.xrPresenting && vrdeform.state.xrFrames > 10));
+
+  const step = () => page.evaluate(() => vrdeform.state.study);
+  // Points the right controller at a board button and pulls the trigger.
+  const press = async (action, item, value) => {
+    const aim = await until(`the board's ${action} button`, () =>
+      page.evaluate(([a, i, v]) => vrdeform.aimAtButton(a, i ?? undefined, v ?? undefined), [action, item, value]));
+    await page.evaluate((aim) => {
+      const c = __xrDevice.controllers.right;
+      c.position.set(...aim.position);
+      c.quaternion.set(...aim.quaternion);
+    }, aim);
+    await sleep(150);
+    await page.evaluate(() => __xrDevice.controllers.right.updateButtonValue('trigger', 1));
+    await sleep(150);
+    await page.evaluate(() => __xrDevice.controllers.right.updateButtonValue('trigger', 0));
+    await sleep(150);
+  };
+  const waitFor = (what, check) =>
+    until(what, async () => {
+      const s = await step();
+      return s && check(s) ? s : null;
+    }, 30000);
+
+  const pressed = [];
+  for (let part = 1; part <= 2; ++part) {
+    await waitFor(`part ${part}'s trial`, (s) => s.step === 'trial' && !s.started && s.title.startsWith(`Part ${part} `));
+    await press('start');
+    await waitFor(`part ${part}'s trial to start`, (s) => s.step === 'trial' && s.started);
+    const asked = await waitFor(`part ${part}'s questions`, (s) => s.step === 'questions');
+    assert.deepEqual(asked.items.map((i) => i.text), ['The force grew as I pressed.', 'The liver looked soft.']);
+    const answers = [part + 1, 5 - part]; // 2, 4 then 3, 3
+    await press('rate', 0, answers[0]);
+    await press('rate', 1, answers[1]);
+    await until('the board to show the ratings', () => page.evaluate(() => vrdeform.study.ratings.every((v) => v !== null)));
+    await press('submit');
+    pressed.push(answers);
+    if (part === 1) {
+      await waitFor('the rest', (s) => s.step === 'rest');
+      await sleep(1200); // Continue is offered once the rest is over
+      await press('continue');
+    }
+  }
+  const last = await waitFor('the final questions', (s) => s.step === 'questions' && s.items.length === 2);
+  assert.deepEqual(last.items.map((i) => i.rated), [true, false]);
+  assert.deepEqual([last.items[0].lowAnchor, last.items[0].highAnchor], ['part 1', 'part 2']);
+  await press('rate', 0, -2);
+  await press('submit');
+  await waitFor('the end', (s) => s.step === 'done');
+  const { code } = await exited;
+  assert.equal(code, 0, output());
+
+  // P1's order is A then B (Latin square row 1); the answers are the ones pressed.
+  const folder = path.join(data, 'P1');
+  const answers = readFileSync(path.join(folder, 'answers.csv'), 'utf8');
+  assert.match(answers, new RegExp(`A,H1,${pressed[0][0]}\\n`));
+  assert.match(answers, new RegExp(`A,V1,${pressed[0][1]}\\n`));
+  assert.match(answers, new RegExp(`B,H1,${pressed[1][0]}\\n`));
+  assert.match(answers, new RegExp(`B,V1,${pressed[1][1]}\\n`));
+  assert.match(readFileSync(path.join(folder, 'comparisons.csv'), 'utf8'), /D1,-2\n/);
+  // Each trial recorded its length in steps (0.5 s at the liver's 60 Hz) and its signal.
+  for (const [position, condition] of [[1, 'A'], [2, 'B']]) {
+    const trial = path.join(folder, 'trials', `${position}-1-1`);
+    const record = JSON.parse(readFileSync(path.join(trial, 'trial.json'), 'utf8'));
+    assert.equal(record.condition, condition);
+    assert.equal(record.steps, 30);
+    // The header, a row per step, and the release's row of zeros at the end.
+    assert.equal(readFileSync(path.join(trial, 'forces.csv'), 'utf8').trim().split('\n').length, 32);
+  }
+  assert.deepEqual(errors, [], `page errors: ${errors.join('\n')}`);
 });

@@ -84,13 +84,25 @@ struct QuantBox {
 /// positions quantise to the box's origin. Returns the block's bytes.
 std::vector<std::uint8_t> encodeBodyBlock(std::uint32_t body, std::span<const Vec3> positions, QuantBox& box);
 
+/// What a participant did on a study's panel (`vrdeform study run --vr`, docs/vr.md#study).
+struct StudyReply {
+  enum class Action { Start, Continue, Submit, Retry };
+  std::uint64_t panel = 0;  ///< the panel it answers (the server's "id"): a reply to an older one is stale
+  Action action = Action::Start;
+  std::vector<int> ratings;        ///< Submit: per rated item, in the panel's order
+  std::vector<std::string> texts;  ///< Submit: per free-text item, in the panel's order
+};
+inline constexpr std::size_t kMaxStudyItems = 256;       ///< ratings or texts in one reply
+inline constexpr std::size_t kMaxStudyTextBytes = 4000;  ///< of one free-text answer
+
 /// What a page sends (docs/vr.md#client-messages).
 struct ClientMessage {
-  enum class Type { Hello, Input, Ping };
+  enum class Type { Hello, Input, Ping, Study };
   Type type = Type::Hello;
   XrInput input;        ///< Input
   double pingTime = 0;  ///< Ping: echoed back in the pong
   std::string client;   ///< Hello: the page's name for itself (at most 64 characters)
+  StudyReply study;     ///< Study
 };
 
 /// Largest nesting of JSON arrays and objects accepted (the deepest real message has 3).

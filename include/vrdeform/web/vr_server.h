@@ -20,6 +20,7 @@
 #include "vrdeform/interact/live_hand_input.h"
 #include "vrdeform/scene/simulation_loop.h"
 #include "vrdeform/web/tls_identity.h"
+#include "vrdeform/web/vr_protocol.h"
 #include "vrdeform/web/xr_hand.h"
 
 namespace vrd {
@@ -42,6 +43,9 @@ struct VrServerSettings {
   std::function<bool()> gloveConnected;
   /// Serve HTTPS and WSS with this certificate instead of HTTP and WS (tls_identity.h).
   std::optional<TlsIdentity> tls;
+  /// What participants do on a study's panel (setPanel), called on the I/O thread (must not block);
+  /// null: study messages are rejected.
+  std::function<void(const vr::StudyReply&)> onStudy;
   /// Where log lines go (connections, rejected input); default: stderr.
   std::function<void(std::string_view)> log;
 };
@@ -67,9 +71,10 @@ struct VrServerStats {
 
 class VrServer {
  public:
-  /// Serves `scene` while `loop` runs it (both must outlive the server) from the web folder `web`
-  /// (webFolder()). `hand`, when given, is the loop's input and follows the viewers' hands; null:
-  /// viewers only watch. Binds nothing yet.
+  /// Serves `scene` while `loop` runs it (both must outlive the server, or a later show()) from the
+  /// web folder `web` (webFolder()). `hand`, when given, is the loop's input and follows the viewers'
+  /// hands; null: viewers only watch. The loop must not have started: its world as it is now is the
+  /// viewers' first frame. Binds nothing yet.
   VrServer(SimulationLoop& loop, const BuiltScene& scene, std::filesystem::path web, VrServerSettings settings,
            LiveHandInput* hand = nullptr);
   /// stop().
@@ -81,6 +86,14 @@ class VrServer {
   void start();
   /// Closes every connection (going away) and joins the I/O thread; idempotent.
   void stop();
+  /// Shows another scene from now on, as the constructor's (the loop not started yet): every viewer
+  /// gets its scene message and topology anew; the hand waits at `park` (XrHandSettings::park)
+  /// while no viewer drives it. Returns once the server has let go of the previous scene, loop and
+  /// hand, which may then be destroyed. From the thread that starts and stops the server.
+  void show(SimulationLoop& loop, const BuiltScene& scene, LiveHandInput* hand, const Vec3& park);
+  /// A study's panel (a "study" JSON message, docs/vr.md#study): sent to every viewer now and to
+  /// each one that connects later; empty: none.
+  void setPanel(std::string json);
   /// The port listened on (after start()).
   std::uint16_t port() const;
   VrServerStats stats() const;
