@@ -113,8 +113,7 @@ class StudyInVr {
       SimulationLoopSettings ls;
       ls.input = o_.autopilot ? nullptr : &next->hand;
       if (trial) {
-        const double seconds = p_.task(s).seconds > 0.0 ? p_.task(s).seconds : c.spec.seconds;
-        ls.maxSteps = std::uint64_t(std::max(std::lround(seconds / c.spec.solver.timeStep), 1L));
+        ls.maxSteps = p_.trialSteps(s);
         trialSeconds_ = double(ls.maxSteps) * c.spec.solver.timeStep;
         next->trial.emplace(ls, next->scene, c, glove_ ? &glove_->output() : nullptr, p_.beginTrial() / "forces.csv");
         taskEnd_.emplace(p_.task(s).end);

@@ -502,9 +502,8 @@ void Viewer::prepareStudyStep(bool first) {
   loop_.paused = true;
   if (trial) {
     const StudyCondition& c = p.condition(s);
-    const double seconds = p.task(s).seconds > 0.0 ? p.task(s).seconds : c.spec.seconds;
     spec_ = c.spec;
-    loop_.maxSteps = std::uint64_t(std::max(std::lround(seconds / spec_.solver.timeStep), 1L));
+    loop_.maxSteps = p.trialSteps(s);
     loop_.forces = p.beginTrial() / "forces.csv";
     loop_.condition = &c;
     taskEnd_.emplace(p.task(s).end);

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <ctime>
 #include <nlohmann/json.hpp>
 
@@ -119,6 +120,12 @@ const StudyCondition& ParticipantProgress::condition(const StudyStep& step) cons
 
 const StudyTask& ParticipantProgress::task(const StudyStep& step) const {
   return step.kind == StudyStepKind::Practice ? study_.practice->task : study_.tasks[step.task];
+}
+
+std::uint64_t ParticipantProgress::trialSteps(const StudyStep& step) const {
+  const SceneSpec& spec = condition(step).spec;
+  const double seconds = task(step).seconds > 0.0 ? task(step).seconds : spec.seconds;
+  return std::uint64_t(std::max(std::lround(seconds / spec.solver.timeStep), 1L));
 }
 
 fs::path ParticipantProgress::trialFolder(const StudyStep& step) const {

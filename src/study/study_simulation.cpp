@@ -71,9 +71,8 @@ TrialRecord runTrial(ParticipantProgress& progress, const StudyRunSettings& sett
   SceneBuildObserver observer;
   observer.stop = settings.stop;
   BuiltScene scene = buildScene(spec, observer);
-  const double seconds = progress.task(step).seconds > 0.0 ? progress.task(step).seconds : spec.seconds;
   RunSettings run;
-  run.steps = std::uint64_t(std::lround(seconds / spec.solver.timeStep));
+  run.steps = progress.trialSteps(step);
   run.outDir = progress.beginTrial();
   std::vector<double> depth, felt;
   bool stopped = false, ended = false;

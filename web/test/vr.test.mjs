@@ -286,10 +286,11 @@ test('the desktop page: the force panel in view, poking with the mouse', { timeo
 });
 
 // `vrdeform study run --vr`: participant 1 of a two-condition study walked through it in the
-// emulated headset: each trial's Start, the questionnaire after each condition, the rest's
-// Continue and the final comparison pressed on the study board with the controller's ray (trigger);
-// then the answers in the participant's folder are the ones pressed.
-test('a study on the VR page: trials, questionnaires and a rest answered with the controller', { timeout: 170000 }, async (t) => {
+// emulated headset: each trial's Start, the questionnaire after each condition and the rest's
+// Continue pressed on the study board with the controller's ray (trigger); the final questions
+// (a comparison and a free-text item) on the desktop form once out of VR. The answers in the
+// participant's folder are the ones given.
+test('a study on the VR page: trials, questionnaires and a rest with the controller, the last on the form', { timeout: 170000 }, async (t) => {
   const work = mkdtempSync(path.join(tmpdir(), 'vrdeform-study-'));
   t.after(() => rmSync(work, { recursive: true, force: true }));
   const studyFile = path.join(work, 'study.toml');
@@ -355,23 +356,33 @@ after = "study"
       c.position.set(...aim.position);
       c.quaternion.set(...aim.quaternion);
     }, aim);
-    await sleep(150);
+    // Each change is seen by an XR frame before the next: the select fires on the frame the
+    // trigger goes down, with the pose set before it.
+    const frames = async () => {
+      const n = await page.evaluate(() => vrdeform.state.xrFrames);
+      await until('two XR frames', () => page.evaluate((n) => vrdeform.state.xrFrames >= n + 2, n));
+    };
+    await frames();
     await page.evaluate(() => __xrDevice.controllers.right.updateButtonValue('trigger', 1));
-    await sleep(150);
+    await frames();
     await page.evaluate(() => __xrDevice.controllers.right.updateButtonValue('trigger', 0));
-    await sleep(150);
+    await frames();
   };
   const waitFor = (what, check) =>
     until(what, async () => {
       const s = await step();
       return s && check(s) ? s : null;
-    }, 30000);
+    }, 30000).catch(async (e) => {
+      const seen = await page.evaluate(() => ({ study: vrdeform.state.study, sent: vrdeform.study.sent }));
+      assert.fail(`${e.message}: the page has ${JSON.stringify(seen)}; the server said:\n${output()}`);
+    });
 
   const pressed = [];
   for (let part = 1; part <= 2; ++part) {
     await waitFor(`part ${part}'s trial`, (s) => s.step === 'trial' && !s.started && s.title.startsWith(`Part ${part} `));
     await press('start');
-    await waitFor(`part ${part}'s trial to start`, (s) => s.step === 'trial' && s.started);
+    // (The half-second trial may be over by the time the page is asked.)
+    await waitFor(`part ${part}'s trial to start`, (s) => (s.step === 'trial' && s.started) || s.step === 'questions');
     const asked = await waitFor(`part ${part}'s questions`, (s) => s.step === 'questions');
     assert.deepEqual(asked.items.map((i) => i.text), ['The force grew as I pressed.', 'The liver looked soft.']);
     const answers = [part + 1, 5 - part]; // 2, 4 then 3, 3
@@ -389,8 +400,15 @@ after = "study"
   const last = await waitFor('the final questions', (s) => s.step === 'questions' && s.items.length === 2);
   assert.deepEqual(last.items.map((i) => i.rated), [true, false]);
   assert.deepEqual([last.items[0].lowAnchor, last.items[0].highAnchor], ['part 1', 'part 2']);
-  await press('rate', 0, -2);
-  await press('submit');
+  // The last questions on the desktop form (a free-text item is typed there): out of VR, the form
+  // shows the step.
+  await page.evaluate(() => document.getElementById('VRButton').click()); // under iwer's overlay
+  await until('the session to end', () => page.evaluate(() => !vrdeform.state.xrPresenting));
+  await page.waitForSelector('#study:not([hidden]) textarea');
+  assert.equal(await page.isDisabled('#study button[data-action=submit]'), true, 'Submit waits for the rating');
+  await page.check('#study input[name=item0][value="-2"]');
+  await page.fill('#study textarea', 'smooth, then "firm"');
+  await page.click('#study button[data-action=submit]');
   await waitFor('the end', (s) => s.step === 'done');
   const { code } = await exited;
   assert.equal(code, 0, output());
@@ -403,6 +421,9 @@ after = "study"
   assert.match(answers, new RegExp(`B,H1,${pressed[1][0]}\\n`));
   assert.match(answers, new RegExp(`B,V1,${pressed[1][1]}\\n`));
   assert.match(readFileSync(path.join(folder, 'comparisons.csv'), 'utf8'), /D1,-2\n/);
+  assert.deepEqual(JSON.parse(readFileSync(path.join(folder, 'free_text.json'), 'utf8')), [
+    { item: 'F1', text: 'smooth, then "firm"' },
+  ]);
   // Each trial recorded its length in steps (0.5 s at the liver's 60 Hz) and its signal.
   for (const [position, condition] of [[1, 'A'], [2, 'B']]) {
     const trial = path.join(folder, 'trials', `${position}-1-1`);

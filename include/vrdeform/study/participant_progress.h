@@ -77,6 +77,8 @@ class ParticipantProgress {
   /// The condition a practice or trial step runs (the practice's own for Practice).
   const StudyCondition& condition(const StudyStep& step) const;
   const StudyTask& task(const StudyStep& step) const;
+  /// The steps a practice or trial step runs at most: its task's seconds, else its scene's length.
+  std::uint64_t trialSteps(const StudyStep& step) const;
   /// The folder a practice or trial step's files end up in.
   std::filesystem::path trialFolder(const StudyStep& step) const;
   /// Trials finished by an earlier run when this one began.

@@ -28,7 +28,6 @@ class TrialOutputs {
   /// After the loop stopped: forces.csv complete, events.csv and latency.csv beside it. Throws
   /// vrd::Error when the signal could not be written.
   void finish(const SimulationLoop& loop);
-  const TrialEvents& events() const { return *events_; }
 
  private:
   std::optional<OscOutput> osc_;
