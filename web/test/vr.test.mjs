@@ -98,11 +98,11 @@ async function headsetPage(context) {
   return { page, errors };
 }
 
-// Starts `vrdeform serve liver` with `serverArgs`, then Chromium with the flags
+// Starts `vrdeform serve liver` (or `command`) with `serverArgs`, then Chromium with the flags
 // `browserArgs(serverOutput)` gives; both are closed when the test ends. stop() closes the browser
 // and checks that the server stops cleanly on SIGTERM.
-async function serveAndBrowse(t, serverArgs = [], browserArgs = () => []) {
-  const { server, url, exited, output } = startServer(serverArgs);
+async function serveAndBrowse(t, serverArgs = [], browserArgs = () => [], command = undefined) {
+  const { server, url, exited, output } = startServer(serverArgs, command);
   const profile = mkdtempSync(path.join(tmpdir(), 'vrdeform-chromium-'));
   let browser;
   t.after(async () => {
@@ -120,7 +120,7 @@ async function serveAndBrowse(t, serverArgs = [], browserArgs = () => []) {
     assert.equal(code, 0, output());
   };
   const status = async () => (await fetch(`${base}status.json`)).json();
-  return { base, browser, output, status, stop };
+  return { base, browser, output, status, stop, exited };
 }
 
 test('the VR page in an emulated headset: both eyes, mesh frames, poke and grasp', { timeout: 150000 }, async (t) => {
@@ -330,16 +330,8 @@ after = "study"
 `,
   );
   const data = path.join(work, 'data');
-  const { server, url, exited, output } = startServer([], ['study', 'run', studyFile, data, '--participant', '1', '--vr']);
-  const profile = mkdtempSync(path.join(tmpdir(), 'vrdeform-chromium-'));
-  let browser;
-  t.after(async () => {
-    if (browser) await browser.close().catch(() => {});
-    if (server.exitCode === null) server.kill('SIGKILL');
-    rmSync(profile, { recursive: true, force: true });
-  });
-  const base = await url;
-  browser = await openHeadset(profile);
+  const command = ['study', 'run', studyFile, data, '--participant', '1', '--vr'];
+  const { base, browser, output, exited } = await serveAndBrowse(t, [], () => [], command);
   const { page, errors } = await headsetPage(browser);
   await page.goto(base);
   await until('the study panel', () => page.evaluate(() => vrdeform.state.study && vrdeform.state.framesReceived > 0), 30000);
