@@ -29,7 +29,8 @@ export function createStudyPanel(send) {
   form.hidden = true;
   document.body.appendChild(form);
 
-  const panel = { mesh, form, message: null, ratings: [], texts: [], buttons: [], drawn: '', restEnds: 0, sent: 0 };
+  const panel = { mesh, form, message: null, ratings: [], texts: [], buttons: [], drawn: '', restEnds: 0, sent: 0,
+                  continueButton: null };
 
   const reply = (action) => {
     const m = panel.message;
@@ -37,7 +38,6 @@ export function createStudyPanel(send) {
     send({ type: 'study', panel: m.id, action, ...answers });
     panel.sent++;
   };
-  const rated = () => (panel.message.items || []).filter((i) => i.rated);
   const complete = () => panel.ratings.every((v) => v !== null);
   const restLeft = () => Math.max(0, (panel.restEnds - performance.now()) / 1000);
 
@@ -134,6 +134,7 @@ export function createStudyPanel(send) {
   function buildForm() {
     const m = panel.message;
     form.replaceChildren();
+    panel.continueButton = null;
     const add = (tag, props = {}, parent = form) => parent.appendChild(Object.assign(document.createElement(tag), props));
     add('h2', { textContent: m.title });
     if (m.text) add('p', { textContent: m.text });

@@ -287,7 +287,8 @@ test('the desktop page: the force panel in view, poking with the mouse', { timeo
 
 // `vrdeform study run --vr`: participant 1 of a two-condition study walked through it in the
 // emulated headset: each trial's Start, the questionnaire after each condition and the rest's
-// Continue pressed on the study board with the controller's ray (trigger); the final questions
+// Continue pressed on the study board with the controller's ray (trigger) in the first part and
+// a tracked hand's (pinch) in the second; the final questions
 // (a comparison and a free-text item) on the desktop form once out of VR. The answers in the
 // participant's folder are the ones given.
 test('a study on the VR page: trials, questionnaires and a rest with the controller, the last on the form', { timeout: 170000 }, async (t) => {
@@ -340,24 +341,38 @@ after = "study"
 
   const step = () => page.evaluate(() => vrdeform.state.study);
   // Points the right controller at a board button and pulls the trigger.
-  const press = async (action, item, value) => {
+  // Points the right controller's or tracked hand's target ray at a board button (`input`:
+  // 'controller' or 'hand') and pulls the trigger or pinches.
+  const press = async (input, action, item, value) => {
     const aim = await until(`the board's ${action} button`, () =>
       page.evaluate(([a, i, v]) => vrdeform.aimAtButton(a, i ?? undefined, v ?? undefined), [action, item, value]));
-    await page.evaluate((aim) => {
-      const c = __xrDevice.controllers.right;
-      c.position.set(...aim.position);
-      c.quaternion.set(...aim.quaternion);
-    }, aim);
+    await page.evaluate(
+      ({ aim, input }) => {
+        __xrDevice.primaryInputMode = input;
+        const c = input === 'hand' ? __xrDevice.hands.right : __xrDevice.controllers.right;
+        c.position.set(...aim.position);
+        c.quaternion.set(...aim.quaternion);
+      },
+      { aim, input },
+    );
     // Each change is seen by an XR frame before the next: the select fires on the frame the
-    // trigger goes down, with the pose set before it.
+    // trigger goes down (or the pinch closes), with the pose set before it.
     const frames = async () => {
       const n = await page.evaluate(() => vrdeform.state.xrFrames);
       await until('two XR frames', () => page.evaluate((n) => vrdeform.state.xrFrames >= n + 2, n));
     };
+    const select = (input, value) =>
+      page.evaluate(
+        ([input, value]) =>
+          input === 'hand'
+            ? __xrDevice.hands.right.updatePinchValue(value)
+            : __xrDevice.controllers.right.updateButtonValue('trigger', value),
+        [input, value],
+      );
     await frames();
-    await page.evaluate(() => __xrDevice.controllers.right.updateButtonValue('trigger', 1));
+    await select(input, 1);
     await frames();
-    await page.evaluate(() => __xrDevice.controllers.right.updateButtonValue('trigger', 0));
+    await select(input, 0);
     await frames();
   };
   const waitFor = (what, check) =>
@@ -371,22 +386,23 @@ after = "study"
 
   const pressed = [];
   for (let part = 1; part <= 2; ++part) {
+    const input = part === 1 ? 'controller' : 'hand'; // the second part with a tracked hand's pinch
     await waitFor(`part ${part}'s trial`, (s) => s.step === 'trial' && !s.started && s.title.startsWith(`Part ${part} `));
-    await press('start');
+    await press(input, 'start');
     // (The half-second trial may be over by the time the page is asked.)
     await waitFor(`part ${part}'s trial to start`, (s) => (s.step === 'trial' && s.started) || s.step === 'questions');
     const asked = await waitFor(`part ${part}'s questions`, (s) => s.step === 'questions');
     assert.deepEqual(asked.items.map((i) => i.text), ['The force grew as I pressed.', 'The liver looked soft.']);
     const answers = [part + 1, 5 - part]; // 2, 4 then 3, 3
-    await press('rate', 0, answers[0]);
-    await press('rate', 1, answers[1]);
+    await press(input, 'rate', 0, answers[0]);
+    await press(input, 'rate', 1, answers[1]);
     await until('the board to show the ratings', () => page.evaluate(() => vrdeform.study.ratings.every((v) => v !== null)));
-    await press('submit');
+    await press(input, 'submit');
     pressed.push(answers);
     if (part === 1) {
       await waitFor('the rest', (s) => s.step === 'rest');
       await sleep(1200); // Continue is offered once the rest is over
-      await press('continue');
+      await press(input, 'continue');
     }
   }
   const last = await waitFor('the final questions', (s) => s.step === 'questions' && s.items.length === 2);
