@@ -176,11 +176,12 @@ std::function<int()> addStudyCommand(CLI::App& app) {
   runCmd->add_flag("--autopilot", a->autopilot,
                    "A dry run of the set-up: every step starts by itself, the scenes' scripted hands poke, the "
                    "questions get the scales' middles and rests are skipped");
-  runCmd->add_flag(
+  CLI::Option* vr = runCmd->add_flag(
       "--vr", a->vr,
       "On the VR page instead of the desktop viewer: the headset (or a browser) opens the address printed, "
       "and the instructions and questions are on a panel there; --port, --bind, --tls and --fps as serve's");
   addServeOptions(*runCmd, a->serve);
+  for (const char* name : {"--port", "--bind", "--tls", "--tls-dir", "--fps"}) runCmd->get_option(name)->needs(vr);
   return [a, checkCmd, analyseCmd, simulateCmd, runCmd]() -> int {
     if (*runCmd) return runLive(*a);
     if (*checkCmd) return check(*a);
