@@ -155,7 +155,7 @@ export function createStudyPanel(send) {
       add('legend', { textContent: item.text }, p);
       if (!item.rated) {
         const k = t++;
-        const area = add('textarea', { rows: 3, maxLength: 4000 }, p);
+        const area = add('textarea', { rows: 3, maxLength: 4000, value: panel.texts[k] }, p);
         area.oninput = () => (panel.texts[k] = area.value);
         continue;
       }
@@ -163,7 +163,7 @@ export function createStudyPanel(send) {
       add('span', { className: 'anchor', textContent: item.lowAnchor }, p);
       for (let v = item.low; v <= item.high; ++v) {
         const label = add('label', {}, p);
-        const input = add('input', { type: 'radio', name: `item${k}`, value: String(v) }, label);
+        const input = add('input', { type: 'radio', name: `item${k}`, value: String(v), checked: panel.ratings[k] === v }, label);
         input.onchange = () => {
           panel.ratings[k] = v;
           submit.disabled = !complete();
@@ -180,7 +180,10 @@ export function createStudyPanel(send) {
     panel,
     // A "study" message from the server.
     show(m) {
-      const fresh = !panel.message || panel.message.id !== m.id;
+      // The same questions again (a refusal said on the panel) keep what was answered.
+      const was = panel.message;
+      const fresh =
+        !was || was.step !== m.step || was.title !== m.title || JSON.stringify(was.items) !== JSON.stringify(m.items);
       panel.message = m;
       if (fresh && m.step === 'questions') {
         panel.ratings = m.items.filter((i) => i.rated).map(() => null);

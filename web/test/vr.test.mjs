@@ -395,6 +395,22 @@ after = "study"
     assert.deepEqual(asked.items.map((i) => i.text), ['The force grew as I pressed.', 'The liver looked soft.']);
     const answers = [part + 1, 5 - part]; // 2, 4 then 3, 3
     await press(input, 'rate', 0, answers[0]);
+    if (part === 1) {
+      // A reply the page never sends, from another connection: a rating off the scale. Refused,
+      // with the reason on the panel; nothing is written, the rating already given stays, and the
+      // participant goes on.
+      await page.evaluate(async (id) => {
+        const ws = new WebSocket(`ws://${location.host}/ws`);
+        await new Promise((resolve) => (ws.onopen = resolve));
+        ws.send(JSON.stringify({ type: 'study', panel: id, action: 'submit', ratings: [9, 1], texts: [] }));
+        await new Promise((resolve) => setTimeout(resolve, 300));
+        ws.close();
+      }, asked.id);
+      const refused = await waitFor('the refusal on the panel', (s) => s.step === 'questions' && s.error);
+      assert.equal(refused.error, 'answer to H1: 9 is not on the scale 1..5');
+      assert.ok(!existsSync(path.join(data, 'P1', 'answers.csv')), 'nothing written for a refused answer');
+      assert.deepEqual(await page.evaluate(() => vrdeform.study.ratings), [answers[0], null]);
+    }
     await press(input, 'rate', 1, answers[1]);
     await until('the board to show the ratings', () => page.evaluate(() => vrdeform.study.ratings.every((v) => v !== null)));
     await press(input, 'submit');
