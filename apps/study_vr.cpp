@@ -188,6 +188,17 @@ class StudyInVr {
     }
     if (!error_.empty()) m["error"] = error_;
     server_->setPanel(m.dump());
+    // The experimenter, at the desktop, follows the steps here, with the conditions' names.
+    const bool named = s.kind == StudyStepKind::Trial || s.kind == StudyStepKind::ConditionQuestions;
+    std::string line =
+        fmt::format("P{}: {}{}{}", p_.participant(), m["title"].get<std::string>(),
+                    named ? fmt::format(" [condition {}]", p_.condition(s).name) : "", started_ ? " (running)" : "");
+    if (!error_.empty()) line += fmt::format(" ({})", error_);
+    if (line != lastLine_) {
+      fmt::print("{}\n", line);
+      std::fflush(stdout);
+      lastLine_ = std::move(line);
+    }
   }
 
   double restLeft() const {
@@ -297,7 +308,7 @@ class StudyInVr {
   std::optional<TaskEndWatch> taskEnd_;
   double trialSeconds_ = 0.0;
   bool started_ = false, stopped_ = false, failed_ = false, endMet_ = false;
-  std::string error_;
+  std::string error_, lastLine_;
   Clock::time_point trialBegan_, restBegan_;
   std::optional<VrServer> server_;  // declared last: stopped before anything it calls or shows goes
 };

@@ -47,6 +47,9 @@ kill -TERM $pid && wait $pid || true  # the fake flushes its log as it exits
 trap - EXIT
 grep -q "serving on http://127.0.0.1:" "$dir/P1.txt" || { cat "$dir/P1.txt"; fail "no address printed"; }
 grep -q "P1: done" "$dir/P1.txt" || { cat "$dir/P1.txt"; fail "P1 not done"; }
+# The experimenter follows each step at the console, with the condition's name.
+grep -q "^P1: Part 2 of 2: poke, trial 1 of 1 \[condition B\] (running)" "$dir/P1.txt" ||
+  { cat "$dir/P1.txt"; fail "the steps are not printed"; }
 [ "$(cat "$data/P1/answers.csv")" = "$(printf 'condition,item,answer\nA,H1,4\nB,H1,4')" ] ||
   fail "answers: $(cat "$data/P1/answers.csv")"
 for t in 1 2; do
