@@ -23,6 +23,7 @@ export function createStudyPanel(send) {
     new THREE.PlaneGeometry(1, 1),
     new THREE.MeshBasicMaterial({ map: texture, transparent: true, side: THREE.DoubleSide }),
   );
+  mesh.scale.set(BOARD_WIDTH, (BOARD_WIDTH * canvas.height) / WIDTH, 1);
   mesh.visible = false;
   const form = document.createElement('div');
   form.id = 'study';
@@ -87,12 +88,16 @@ export function createStudyPanel(send) {
     g.fillStyle = 'rgba(20, 24, 32, 0.92)';
     g.fillRect(0, 0, WIDTH, height);
     g.textBaseline = 'middle';
-    const text = (s, x, y, size, colour = '#e0e6f0', align = 'left') => {
-      g.font = `${size}px sans-serif`;
+    // A line of text in at most `room` pixels: its font shrunk to 60% first, then cut.
+    const text = (s, x, y, size, colour = '#e0e6f0', align = 'left', room = WIDTH - 2 * MARGIN) => {
       g.fillStyle = colour;
       g.textAlign = align;
       let t = String(s);
-      while (t.length > 4 && g.measureText(t).width > WIDTH - 2 * MARGIN) t = t.slice(0, -2);
+      for (let px = size; ; px -= 1) {
+        g.font = `${px}px sans-serif`;
+        if (g.measureText(t).width <= room || px <= 0.6 * size) break;
+      }
+      while (t.length > 4 && g.measureText(`${t}…`).width > room) t = t.slice(0, -2);
       g.fillText(t === String(s) ? t : `${t}…`, x, y);
     };
     text(m.title, MARGIN, MARGIN + 20, 34);
@@ -115,9 +120,10 @@ export function createStudyPanel(send) {
         }
         text(item.text, MARGIN, y + 14, 24);
         const row = buttons.filter((b) => b.action === 'rate' && b.y === y + 38);
-        text(item.lowAnchor, row[0].x - 12, y + 38 + BUTTON_H / 2, 20, '#9aa4b4', 'right');
         const last = row[row.length - 1];
-        text(item.highAnchor, last.x + last.w + 12, y + 38 + BUTTON_H / 2, 20, '#9aa4b4');
+        const room = row[0].x - 12 - MARGIN;
+        text(item.lowAnchor, row[0].x - 12, y + 38 + BUTTON_H / 2, 20, '#9aa4b4', 'right', room);
+        text(item.highAnchor, last.x + last.w + 12, y + 38 + BUTTON_H / 2, 20, '#9aa4b4', 'left', room);
         y += ROW;
       }
     }
