@@ -8,24 +8,16 @@ set -eu
 vrdeform=$1 fake=$2 dir=$3 fingers=$4
 shift 4
 mkdir -p "$dir"
+. "$(dirname "$0")/fake_weart.sh"
 printf '# t thumb index middle\n0 0 0 0\n1 0.9 0.9 0.9\n' > "$dir/close.script"
-"$fake" --port 0 --seconds 120 --script "$dir/close.script" --log "$dir/fake.log" > "$dir/fake.out" 2>&1 &
-pid=$!
-trap 'kill $pid 2>/dev/null || true' EXIT
-for _ in $(seq 50); do grep -q '^listening on' "$dir/fake.out" 2>/dev/null && break; sleep 0.1; done
-port=$(sed -n 's/^listening on 127\.0\.0\.1:\([0-9]*\).*/\1/p' "$dir/fake.out")
-[ -n "$port" ] || { echo "the fake middleware did not start"; cat "$dir/fake.out"; exit 1; }
-"$vrdeform" "$@" --weart "127.0.0.1:$port" --seconds "${E2E_SECONDS:-2.5}"
-kill -TERM $pid && wait $pid || true  # the fake flushes its log as it exits
-trap - EXIT
+start_fake "$fake" "$dir" --script "$dir/close.script"
+"$vrdeform" "$@" --weart "127.0.0.1:$fake_port" --seconds "${E2E_SECONDS:-2.5}"
+stop_fake
 echo "--- fake middleware log:"; cat "$dir/fake.log"
 grep -q 'StartFromClient' "$dir/fake.log" || { echo "FAIL: no StartFromClient"; exit 1; }
 if [ "$fingers" != "-" ]; then
   grep -Eq "force RIGHT ($fingers) 0\.[0-9]*[1-9]" "$dir/fake.log" || { echo "FAIL: no $fingers force reached the glove"; exit 1; }
 fi
 grep -q 'StopFromClient' "$dir/fake.log" || { echo "FAIL: no StopFromClient"; exit 1; }
-for point in THUMB INDEX MIDDLE; do
-  last=$(grep -E "(force|stopForce) RIGHT $point" "$dir/fake.log" | tail -1)
-  case "$last" in *stopForce*) ;; *) echo "FAIL: $point left pressing: $last"; exit 1 ;; esac
-done
+released
 echo "PASS: forces sent, every thimble stopped at the end"
