@@ -53,10 +53,10 @@ double hertz(double poisson) {
 // Converged, within 15%: the contact radius (6.3 mm) spans about one cell, so the discrete contact
 // patch is coarse (8 cells across: 1.7 x Hertz; 24 cells: 1.13 x). Warm-started, the held block is a
 // fixed point of any number of iterations (the next test), so 5 give the converged hold (within 3%
-// of 40 cold ones) at an eighth of the cost.
+// of 40 cold ones) at a sixth of the cost.
 TEST(Indentation, AConvergedPokeMeetsHertz) {
 #ifdef __SANITIZE_ADDRESS__
-  GTEST_SKIP() << "minutes of arithmetic under AddressSanitizer; the release build checks the figure";
+  GTEST_SKIP() << "a minute of arithmetic under AddressSanitizer; the release build checks the figure";
 #endif
   for (float poisson : {0.3f, 0.45f}) {
     const double expected = hertz(poisson);  // 1.11 N, 1.27 N
