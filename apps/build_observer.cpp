@@ -10,6 +10,10 @@
 
 namespace vrd {
 
+void printSceneTitle(const SceneSpec& spec) {
+  fmt::print("scene {}{}{}\n", spec.name, spec.description.empty() ? "" : ": ", spec.description);
+}
+
 SceneBuildObserver commandObserver(const StopSignals& signals, bool print) {
   SceneBuildObserver o;
   o.stop = [&signals] { return signals.requested(); };

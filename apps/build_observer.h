@@ -11,4 +11,7 @@ namespace vrd {
 /// `print`: the builder's lines and the settling bar; false: silent (Ctrl-C still stops it).
 SceneBuildObserver commandObserver(const StopSignals& signals, bool print = true);
 
+/// The line a command starts a scene with: "scene NAME: DESCRIPTION", or "scene NAME" without one.
+void printSceneTitle(const SceneSpec& spec);
+
 }  // namespace vrd

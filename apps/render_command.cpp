@@ -26,7 +26,7 @@ struct RenderArgs {
 int render(const RenderArgs& a) {
   prepareOutputFolder(a.out);
   const SceneSpec spec = loadSceneByName(a.scene);
-  fmt::print("scene {}: {}\n", spec.name, spec.description);
+  printSceneTitle(spec);
   const StopSignals signals;
   BuiltScene scene = buildScene(spec, commandObserver(signals));
   std::optional<SceneVideo> video;

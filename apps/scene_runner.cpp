@@ -83,12 +83,19 @@ void printSummary(const RunSummary& r, const BuiltScene& scene) {
       if (r.fingers[f]) fmt::print(" {} {:.3f} ({:.3f} N);", fingerName(Finger(f)), r.forceMax[f], r.newtonsMax[f]);
     fmt::print(" hand (Algorithm 2) {:.3f}\n", r.paperMax);
     for (const PokeSignal& p : r.pokes)
-      for (const auto& [channel, q, unit] : {std::tuple{"N", &p.newtons, " N"}, std::tuple{"normalised", &p.force, ""}})
+      if (!(p.newtons.peak > 0.0))
         fmt::print(
-            "  poke at {:.2f} s ({}, {}): roughness {:.2f}, loading Spearman {:.3f}, hold noise {:.1f}%, lag {} "
-            "steps, peak {:.3f}{}\n",
-            p.start, fingerName(p.finger), channel, q->roughness, q->loadingSpearman, 100 * q->holdNoise, q->lagSteps,
-            q->peak, unit);
+            "  poke at {:.2f} s ({}): never touched the body (nothing was under the fingertip while it pressed: aim it "
+            "with `offset`, or give a body that is still moving more `settle`)\n",
+            p.start, fingerName(p.finger));
+      else
+        for (const auto& [channel, q, unit] :
+             {std::tuple{"N", &p.newtons, " N"}, std::tuple{"normalised", &p.force, ""}})
+          fmt::print(
+              "  poke at {:.2f} s ({}, {}): roughness {:.2f}, loading Spearman {:.3f}, hold noise {:.1f}%, lag {} "
+              "steps, peak {:.3f}{}\n",
+              p.start, fingerName(p.finger), channel, q->roughness, q->loadingSpearman, 100 * q->holdNoise, q->lagSteps,
+              q->peak, unit);
     for (const GraspOutcome& g : r.grasps)
       if (g.heldSeconds > 0.0)
         fmt::print("  grasp at {:.2f} s (thumb and {}): held {:.2f} s of its {:.2f}\n", g.start, fingerName(g.finger),
@@ -241,7 +248,8 @@ int runSceneCommand(const SceneSpec& spec, const RunOptions& a,
   if ((replaying || !a.record.empty()) && !spec.hand.enabled)
     throw Error(fmt::format("scene {} has no hand to record or replay", spec.name));
   if (!a.out.empty()) prepareOutputFolder(a.out);
-  fmt::print("scene {}: {}\n  from {}\n", spec.name, spec.description, spec.source);
+  printSceneTitle(spec);
+  fmt::print("  from {}\n", spec.source);
   const StopSignals signals;  // from here on Ctrl-C stops what runs: meshing, settling, calibrating, the run
   BuiltScene scene = buildScene(spec, commandObserver(signals));
   for (std::size_t b = 0; b < scene.bodies.size(); ++b) {

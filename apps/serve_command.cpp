@@ -105,7 +105,7 @@ namespace {
 
 int serve(const ServeArgs& a) {
   const SceneSpec spec = loadSceneByName(a.scene);
-  fmt::print("scene {}: {}\n", spec.name, spec.description);
+  printSceneTitle(spec);
   std::fflush(stdout);
   const StopSignals signals;
   BuiltScene scene = buildScene(spec, commandObserver(signals, false));
