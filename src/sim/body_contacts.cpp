@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <span>
 
 #include "vrdeform/error.h"
@@ -58,15 +59,34 @@ World::ContactSurface World::contactSurfaceOf(const BodyModel& model) {
   };
   sortUnique(surface.vertices);
   sortUnique(surface.edges);
+  const auto position = [](const auto& sorted, const auto& value) {
+    return Index(std::lower_bound(sorted.begin(), sorted.end(), value) - sorted.begin());
+  };
   surface.edgeFaces.assign(surface.edges.size(), {ContactSurface::kNoFace, ContactSurface::kNoFace});
+  std::vector<Index> vertexOwner(surface.vertices.size(), ContactSurface::kNoFace);
   for (Index t = 0; t < model.surface.size(); ++t)
     for (int k = 0; k < 3; ++k) {
       const Triangle& tri = model.surface[t];
-      const std::array<Index, 2> e{std::min(tri[k], tri[(k + 1) % 3]), std::max(tri[k], tri[(k + 1) % 3])};
-      std::array<Index, 2>& faces = surface.edgeFaces[std::size_t(
-          std::lower_bound(surface.edges.begin(), surface.edges.end(), e) - surface.edges.begin())];
+      std::array<Index, 2>& faces = surface.edgeFaces[position(
+          surface.edges, std::array<Index, 2>{std::min(tri[k], tri[(k + 1) % 3]), std::max(tri[k], tri[(k + 1) % 3])})];
       faces[faces[0] == ContactSurface::kNoFace ? 0 : 1] = t;
+      Index& owner = vertexOwner[position(surface.vertices, tri[k])];
+      if (owner == ContactSurface::kNoFace) owner = t;
     }
+  // Each vertex and edge under its first triangle (counting sort by owner).
+  const auto own = [&](const auto& ownerOf, std::size_t count, std::vector<Index>& start, std::vector<Index>& owned) {
+    start.assign(model.surface.size() + 1, 0);
+    for (std::size_t k = 0; k < count; ++k) ++start[ownerOf(k) + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    owned.resize(count);
+    std::vector<Index> fill(start.begin(), start.end() - 1);
+    for (std::size_t k = 0; k < count; ++k) owned[fill[ownerOf(k)]++] = Index(k);
+  };
+  own([&](std::size_t k) { return vertexOwner[k]; }, surface.vertices.size(), surface.vertexStart,
+      surface.ownedVertices);
+  own([&](std::size_t k) { return surface.edgeFaces[k][0]; }, surface.edges.size(), surface.edgeStart,
+      surface.ownedEdges);
+  surface.tree.build(model.surface, model.restPositions);
   return surface;
 }
 
@@ -81,19 +101,53 @@ Box3f World::sweptBox(Index i, const Vec3& offset, float grow) const {
   return Box3f(box.min().array() - grow, box.max().array() + grow);
 }
 
-// Each substep, from the positions at its start and the predictions, through spatial hashes of
-// each body's surface triangles and edges by their swept boxes (start to prediction, grown by
-// twice the body's thickness): a surface vertex whose swept box meets a triangle's, or an edge
-// whose box meets an edge's, is a candidate against it, and becomes a contact where its contact plane
-// (touchVertexTriangle, touchEdgeEdge, at the substep's start) is within twice the gap plus the
-// pair's motion in the substep. The second gap is a skin: a vertex resting on a surface stays in
-// the set instead of leaving it whenever it lifts by a rounding and coming back a substep later.
-// A vertex or edge that would cross within the substep meets its plane first, however fast (no
-// tunnelling from a state without penetration). A vertex more than the gap behind a plane is taken
-// for the far side of a thin part and left alone. Self-contact leaves out the features that share
-// a corner and those within the gap of each other in the rest shape (not all the features around
-// a vertex: where a surface wrinkles under compression, its faces two apart are the ones that cross),
-// and on a closed surface the edge pairs without a crease (markCreases).
+namespace {
+
+Vec3 faceNormal(const Vec3& x0, const Vec3& x1, const Vec3& x2) { return (x1 - x0).cross(x2 - x0).normalized(); }
+
+}  // namespace
+
+struct World::ContactSides {
+  BodyId a, b;
+  const Body &bodyA, &bodyB;
+  const ContactSurface &surfaceA, &surfaceB;
+  const ContactBroadPhase &broadA, &broadB;
+  Vec3 offsetBA, offsetAB;  // b's frame to a's, and back
+  ContactPair pair;
+  ContactSides swapped() const {
+    return {b, a, bodyB, bodyA, surfaceB, surfaceA, broadB, broadA, offsetAB, offsetBA, pair};
+  }
+};
+
+World::ContactSides World::contactSides(BodyId a, BodyId b) const {
+  return {a,
+          b,
+          bodies_[a],
+          bodies_[b],
+          contactSurfaces_[a],
+          contactSurfaces_[b],
+          broadPhases_[a],
+          broadPhases_[b],
+          offsetBetween(bodies_[b], bodies_[a]),
+          offsetBetween(bodies_[a], bodies_[b]),
+          contactPair(bodyContactSettings_[a], bodyContactSettings_[b])};
+}
+
+// Each substep, from the positions at its start and the predictions: each body's surface tree is
+// refitted to its triangles' swept boxes (start to prediction, grown by twice the body's
+// thickness), and the pairs of triangles whose boxes overlap (of two bodies, or of one body's
+// patches that face apart: surface_tree.h) bring their vertices and edges together
+// (detectTrianglePair). A vertex whose swept box meets a triangle's, or an edge whose box meets an
+// edge's, becomes a contact where its contact plane (touchVertexTriangle, touchEdgeEdge, at the
+// substep's start) is within twice the gap plus the pair's motion in the substep. The second gap
+// is a skin: a vertex resting on a surface stays in the set instead of leaving it whenever it
+// lifts by a rounding and coming back a substep later. A vertex or edge that would cross within
+// the substep meets its plane first, however fast (no tunnelling from a state without
+// penetration). A vertex more than the gap behind a plane is taken for the far side of a thin part
+// and left alone. Self-contact leaves out the features that share a corner and those within the
+// gap of each other in the rest shape (not all the features around a vertex: where a surface
+// wrinkles under compression, its faces two apart are the ones that cross), and on a closed
+// surface the edge pairs without a crease (markCreases).
 void World::detectBodyContacts() {
   bodyContacts_.clear();
   // The bodies that touch something: themselves, or another active body with a surface.
@@ -106,41 +160,42 @@ void World::detectBodyContacts() {
   if (taking.empty()) return;
 
   broadPhases_.resize(bodies_.size());
-  std::size_t mostTriangles = 0, mostEdges = 0;
   for (BodyId id : taking) {
     const Body& b = bodies_[id];
+    ContactSurface& surface = contactSurfaces_[id];
     ContactBroadPhase& broad = broadPhases_[id];
     broad.offset = offsetBetween(b, bodies_[taking.front()]);
-    broad.boxes.clear();
-    broad.bounds.setEmpty();
     const float grow = 2.0f * bodyContactSettings_[id].thickness;
-    double extent = 0.0;
+    const auto swept = [&](Index v) { return sweptBox(b.firstParticle + v, broad.offset, grow); };
+    broad.boxes.clear();
+    broad.startNormals.clear();
+    broad.endNormals.clear();
+    const bool self = bodyContactSettings_[id].self;  // the normals serve self-contact only
     for (const Triangle& t : b.model->surface) {
-      Box3f box = sweptBox(b.firstParticle + t[0], broad.offset, grow);
-      box.extend(sweptBox(b.firstParticle + t[1], broad.offset, grow));
-      box.extend(sweptBox(b.firstParticle + t[2], broad.offset, grow));
-      broad.boxes.push_back(box);
-      broad.bounds.extend(box);
-      if (const float size = box.sizes().maxCoeff(); std::isfinite(size)) extent += size;
+      broad.boxes.push_back(swept(t[0]).extend(swept(t[1])).extend(swept(t[2])));
+      if (!self) continue;
+      const Index i = b.firstParticle;
+      broad.startNormals.push_back(faceNormal(local_[i + t[0]].pos, local_[i + t[1]].pos, local_[i + t[2]].pos));
+      broad.endNormals.push_back(
+          faceNormal(predicted_[i + t[0]].pos, predicted_[i + t[1]].pos, predicted_[i + t[2]].pos));
     }
+    broad.vertexBoxes.clear();
+    for (Index v : surface.vertices) broad.vertexBoxes.push_back(swept(v));
     broad.edgeBoxes.clear();
-    for (const std::array<Index, 2>& e : contactSurfaces_[id].edges)
-      broad.edgeBoxes.push_back(sweptBox(b.firstParticle + e[0], broad.offset, grow)
-                                    .extend(sweptBox(b.firstParticle + e[1], broad.offset, grow)));
+    for (const std::array<Index, 2>& e : surface.edges) broad.edgeBoxes.push_back(swept(e[0]).extend(swept(e[1])));
     markCreases(id);
-    // Cells the size of a typical triangle's box: a vertex's box meets a few cells, a triangle's a few.
-    broad.hash.build(broad.boxes, std::max(float(extent / double(broad.boxes.size())), 1e-6f));
-    broad.edgeHash.build(broad.edgeBoxes, std::max(float(extent / double(broad.boxes.size())), 1e-6f));
-    mostTriangles = std::max(mostTriangles, b.model->surface.size());
-    mostEdges = std::max(mostEdges, contactSurfaces_[id].edges.size());
+    surface.tree.refit(broad.boxes, broad.startNormals, broad.endNormals);
   }
-  seen_.assign(std::max(mostTriangles, mostEdges), 0);
-  contactQuery_ = 0;
-  for (BodyId a : taking)
-    for (BodyId b : taking) {
-      if (!touching(a, b) || !broadPhases_[a].bounds.intersects(broadPhases_[b].bounds)) continue;
-      detectVertexTriangle(a, b);
-      if (b >= a) detectEdgeEdge(a, b);
+  for (std::size_t x = 0; x < taking.size(); ++x)
+    for (std::size_t y = x; y < taking.size(); ++y) {
+      const BodyId a = taking[x], b = taking[y];
+      if (!touching(a, b)) continue;
+      const ContactSides ab = contactSides(a, b);
+      const auto meet = [&](Index t, Index u) { detectTrianglePair(ab, t, u); };
+      if (a == b)
+        contactSurfaces_[a].tree.selfPairs(!bodies_[a].model->tets.empty(), meet);  // a soft body's surface is closed
+      else
+        contactSurfaces_[a].tree.pairsWith(contactSurfaces_[b].tree, meet);
     }
   // The order the warm start matches contacts in.
   std::sort(bodyContacts_.begin(), bodyContacts_.end(),
@@ -153,22 +208,29 @@ void World::detectBodyContacts() {
 // the edge's two faces; a boundary edge (a surface that is not closed) counts as one.
 void World::markCreases(BodyId id) {
   ContactBroadPhase& broad = broadPhases_[id];
-  const Body& b = bodies_[id];
   broad.sharp.clear();
-  if (!bodyContactSettings_[id].self || b.model->tets.empty()) return;  // every edge of a cloth or between bodies
+  if (!bodyContactSettings_[id].self || bodies_[id].model->tets.empty())
+    return;  // every edge of a cloth or between bodies
   const ContactSurface& surface = contactSurfaces_[id];
-  broad.normals.clear();  // each face's once, for its three edges
-  for (const Triangle& tri : b.model->surface) {
-    const Vec3 &x0 = local_[b.firstParticle + tri[0]].pos, &x1 = local_[b.firstParticle + tri[1]].pos,
-               &x2 = local_[b.firstParticle + tri[2]].pos;
-    broad.normals.push_back((x1 - x0).cross(x2 - x0).normalized());
-  }
   constexpr float kCreaseCos = 0.866f;  // faces more than 30 degrees apart
   broad.sharp.resize(surface.edges.size());
   for (std::size_t e = 0; e < surface.edges.size(); ++e) {
     const std::array<Index, 2>& f = surface.edgeFaces[e];
-    broad.sharp[e] = f[1] == ContactSurface::kNoFace || !(broad.normals[f[0]].dot(broad.normals[f[1]]) > kCreaseCos);
+    broad.sharp[e] =
+        f[1] == ContactSurface::kNoFace || !(broad.startNormals[f[0]].dot(broad.startNormals[f[1]]) > kCreaseCos);
   }
+}
+
+// Triangle t of a and u of b (boxes overlapping): each one's vertices against the other, and
+// their edges against each other's.
+void World::detectTrianglePair(const ContactSides& ab, Index t, Index u) {
+  const ContactSurface &sa = ab.surfaceA, &sb = ab.surfaceB;
+  for (Index k = sa.vertexStart[t]; k < sa.vertexStart[t + 1]; ++k) detectVertexTriangle(ab, sa.ownedVertices[k], u);
+  const ContactSides ba = ab.swapped();
+  for (Index k = sb.vertexStart[u]; k < sb.vertexStart[u + 1]; ++k) detectVertexTriangle(ba, sb.ownedVertices[k], t);
+  for (Index k = sa.edgeStart[t]; k < sa.edgeStart[t + 1]; ++k)
+    for (Index l = sb.edgeStart[u]; l < sb.edgeStart[u + 1]; ++l)
+      detectEdgeEdge(ab, sa.ownedEdges[k], sb.ownedEdges[l]);
 }
 
 namespace {
@@ -180,99 +242,71 @@ bool shareCorner(std::span<const Index> f, std::span<const Index> g) {
 
 }  // namespace
 
-void World::detectVertexTriangle(BodyId a, BodyId bId) {
+// Surface vertex `vertex` of a (its position in the surface's vertex list) against triangle t of b.
+void World::detectVertexTriangle(const ContactSides& ab, Index vertex, Index t) {
+  if (!ab.broadA.vertexBoxes[vertex].intersects(ab.broadB.boxes[t])) return;
   const Point* const pred = predicted_.data();
   const Point* const start = local_.data();
-  const Body &body = bodies_[a], &other = bodies_[bId];
-  const float thicknessA = bodyContactSettings_[a].thickness;
-  const ContactSurface& surfaceB = contactSurfaces_[bId];
-  const ContactBroadPhase& broad = broadPhases_[bId];
-  const Vec3 offsetA = broadPhases_[a].offset, offset = offsetBetween(other, body);
-  const std::vector<Vec3>& rest = body.model->restPositions;
-  const ContactPair pair = contactPair(bodyContactSettings_[a], bodyContactSettings_[bId]);
-  const float gap = pair.gap;
-  for (Index v : contactSurfaces_[a].vertices) {
-    const Index i = body.firstParticle + v;
-    const Box3f box = sweptBox(i, offsetA, 2.0f * thicknessA);
-    if (!box.intersects(broad.bounds)) continue;
-    const float motion = (pred[i].pos - start[i].pos).norm();
-    const std::uint32_t query = ++contactQuery_;
-    broad.hash.query(box, [&](Index t) {
-      if (seen_[t] == query) return;
-      seen_[t] = query;
-      if (!box.intersects(broad.boxes[t])) return;
-      const Triangle& tri = other.model->surface[t];
-      if (a == bId && shareCorner(std::span(&v, 1), std::span(tri))) return;
-      const std::array<Index, 4> p{i, other.firstParticle + tri[0], other.firstParticle + tri[1],
-                                   other.firstParticle + tri[2]};
-      if (pred[p[0]].w == 0.0f && pred[p[1]].w == 0.0f && pred[p[2]].w == 0.0f && pred[p[3]].w == 0.0f) return;
-      const std::optional<VertexTriangleTouch> touch = touchVertexTriangle(
-          start[i].pos, start[p[1]].pos + offset, start[p[2]].pos + offset, start[p[3]].pos + offset,
-          !other.model->tets.empty());  // a soft body's surface is closed
-      if (!touch) return;
-      float reach = 0.0f;
-      for (int k = 1; k < 4; ++k) reach = std::max(reach, (pred[p[k]].pos - start[p[k]].pos).norm());
-      if (!(touch->distance >= -gap && touch->distance <= 2.0f * gap + motion + reach)) return;
-      if (a == bId) {  // within the gap at rest: as the body should be
-        const std::array<float, 3> w = closestPointOnTriangle(rest[v], rest[tri[0]], rest[tri[1]], rest[tri[2]]);
-        if ((rest[v] - (w[0] * rest[tri[0]] + w[1] * rest[tri[1]] + w[2] * rest[tri[2]])).norm() <= gap) return;
-      }
-      const std::uint64_t key = std::uint64_t(i) << 32 | (surfaceB.firstTriangleKey + t);
-      bodyContacts_.push_back(
-          {p, {1.0f, -touch->b[0], -touch->b[1], -touch->b[2]}, 1, key, offset, touch->normal, pair});
-    });
+  const Index v = ab.surfaceA.vertices[vertex], i = ab.bodyA.firstParticle + v;
+  const Triangle& tri = ab.bodyB.model->surface[t];
+  const bool self = ab.a == ab.b;
+  if (self && shareCorner(std::span(&v, 1), std::span(tri))) return;
+  const Index first = ab.bodyB.firstParticle;
+  const std::array<Index, 4> p{i, first + tri[0], first + tri[1], first + tri[2]};
+  if (pred[p[0]].w == 0.0f && pred[p[1]].w == 0.0f && pred[p[2]].w == 0.0f && pred[p[3]].w == 0.0f) return;
+  const Vec3& offset = ab.offsetBA;
+  const std::optional<VertexTriangleTouch> touch =
+      touchVertexTriangle(start[i].pos, start[p[1]].pos + offset, start[p[2]].pos + offset, start[p[3]].pos + offset,
+                          !ab.bodyB.model->tets.empty());  // a soft body's surface is closed
+  if (!touch) return;
+  float reach = 0.0f;
+  for (int k = 1; k < 4; ++k) reach = std::max(reach, (pred[p[k]].pos - start[p[k]].pos).norm());
+  const float gap = ab.pair.gap, motion = (pred[i].pos - start[i].pos).norm();
+  if (!(touch->distance >= -gap && touch->distance <= 2.0f * gap + motion + reach)) return;
+  if (self) {  // within the gap at rest: as the body should be
+    const std::vector<Vec3>& rest = ab.bodyA.model->restPositions;
+    const std::array<float, 3> w = closestPointOnTriangle(rest[v], rest[tri[0]], rest[tri[1]], rest[tri[2]]);
+    if ((rest[v] - (w[0] * rest[tri[0]] + w[1] * rest[tri[1]] + w[2] * rest[tri[2]])).norm() <= gap) return;
   }
+  const std::uint64_t key = std::uint64_t(i) << 32 | (ab.surfaceB.firstTriangleKey + t);
+  bodyContacts_.push_back(
+      {p, {1.0f, -touch->b[0], -touch->b[1], -touch->b[2]}, 1, key, offset, touch->normal, ab.pair});
 }
 
-// Each edge pair once: from the body with the lower id (b >= a), within a body from the lower edge.
-void World::detectEdgeEdge(BodyId a, BodyId bId) {
+// Surface edges e of a and f of b (positions in the surfaces' edge lists). Within a body in
+// self-contact only pairs with a crease (markCreases), each from its lower edge: the same contact
+// (key, corner order) from every substep, for the warm start.
+void World::detectEdgeEdge(const ContactSides& ab, Index e, Index f) {
+  if (!ab.broadA.edgeBoxes[e].intersects(ab.broadB.edgeBoxes[f])) return;
+  const bool self = ab.a == ab.b;
+  if (self) {
+    const std::vector<char>& sharp = ab.broadA.sharp;
+    if (!sharp.empty() && !sharp[e] && !sharp[f]) return;
+    if (f < e) std::swap(e, f);
+  }
   const Point* const pred = predicted_.data();
   const Point* const start = local_.data();
-  const Body &body = bodies_[a], &other = bodies_[bId];
-  const ContactSurface &surfaceA = contactSurfaces_[a], &surfaceB = contactSurfaces_[bId];
-  const ContactBroadPhase& broad = broadPhases_[bId];
-  const Vec3 offset = offsetBetween(other, body);
-  const std::vector<Vec3>& rest = body.model->restPositions;
-  const ContactPair pair = contactPair(bodyContactSettings_[a], bodyContactSettings_[bId]);
-  const float gap = pair.gap;
-  // Within a body in self-contact, only creases query (broad.sharp); a pair of two creases once.
-  const std::vector<char>& sharp = broad.sharp;
-  for (Index queried = 0; queried < surfaceA.edges.size(); ++queried) {
-    if (!sharp.empty() && !sharp[queried]) continue;
-    const Box3f& box = broadPhases_[a].edgeBoxes[queried];
-    if (!box.intersects(broad.bounds)) continue;
-    const std::uint32_t query = ++contactQuery_;
-    broad.edgeHash.query(box, [&](Index met) {
-      if (seen_[met] == query) return;
-      seen_[met] = query;
-      if (a == bId && (met == queried || (met < queried && (sharp.empty() || sharp[met])))) return;
-      if (!box.intersects(broad.edgeBoxes[met])) return;
-      // Within a body, each pair from its lower edge, whichever found it: the same contact (key,
-      // corner order) from every substep, for the warm start.
-      const Index e = a == bId ? std::min(queried, met) : queried, f = a == bId ? std::max(queried, met) : met;
-      const std::array<Index, 2>& edge = surfaceA.edges[e];
-      const Index i0 = body.firstParticle + edge[0], i1 = body.firstParticle + edge[1];
-      const float motion = std::max((pred[i0].pos - start[i0].pos).norm(), (pred[i1].pos - start[i1].pos).norm());
-      const std::array<Index, 2>& g = surfaceB.edges[f];
-      if (a == bId && shareCorner(std::span(edge), std::span(g))) return;
-      const std::array<Index, 4> p{i0, i1, other.firstParticle + g[0], other.firstParticle + g[1]};
-      if (pred[p[0]].w == 0.0f && pred[p[1]].w == 0.0f && pred[p[2]].w == 0.0f && pred[p[3]].w == 0.0f) return;
-      const std::optional<EdgeEdgeTouch> touch =
-          touchEdgeEdge(start[p[0]].pos, start[p[1]].pos, start[p[2]].pos + offset, start[p[3]].pos + offset);
-      if (!touch) return;
-      const float reach =
-          std::max((pred[p[2]].pos - start[p[2]].pos).norm(), (pred[p[3]].pos - start[p[3]].pos).norm());
-      if (!(touch->distance <= gap + motion + reach)) return;
-      if (a == bId) {  // within the gap at rest: as the body should be
-        const auto t = touchEdgeEdge(rest[edge[0]], rest[edge[1]], rest[g[0]], rest[g[1]]);
-        if (t && t->distance <= gap) return;
-      }
-      const std::uint64_t key =
-          1ull << 63 | std::uint64_t(surfaceA.firstEdgeKey + e) << 32 | (surfaceB.firstEdgeKey + f);
-      bodyContacts_.push_back(
-          {p, {1.0f - touch->s, touch->s, touch->t - 1.0f, -touch->t}, 2, key, offset, touch->normal, pair});
-    });
+  const std::array<Index, 2>&edge = ab.surfaceA.edges[e], &g = ab.surfaceB.edges[f];
+  if (self && shareCorner(std::span(edge), std::span(g))) return;
+  const Index i0 = ab.bodyA.firstParticle + edge[0], i1 = ab.bodyA.firstParticle + edge[1];
+  const std::array<Index, 4> p{i0, i1, ab.bodyB.firstParticle + g[0], ab.bodyB.firstParticle + g[1]};
+  if (pred[p[0]].w == 0.0f && pred[p[1]].w == 0.0f && pred[p[2]].w == 0.0f && pred[p[3]].w == 0.0f) return;
+  const Vec3& offset = ab.offsetBA;
+  const std::optional<EdgeEdgeTouch> touch =
+      touchEdgeEdge(start[p[0]].pos, start[p[1]].pos, start[p[2]].pos + offset, start[p[3]].pos + offset);
+  if (!touch) return;
+  const float motion = std::max((pred[i0].pos - start[i0].pos).norm(), (pred[i1].pos - start[i1].pos).norm());
+  const float reach = std::max((pred[p[2]].pos - start[p[2]].pos).norm(), (pred[p[3]].pos - start[p[3]].pos).norm());
+  if (!(touch->distance <= ab.pair.gap + motion + reach)) return;
+  if (self) {  // within the gap at rest: as the body should be
+    const std::vector<Vec3>& rest = ab.bodyA.model->restPositions;
+    const auto t = touchEdgeEdge(rest[edge[0]], rest[edge[1]], rest[g[0]], rest[g[1]]);
+    if (t && t->distance <= ab.pair.gap) return;
   }
+  const std::uint64_t key =
+      1ull << 63 | std::uint64_t(ab.surfaceA.firstEdgeKey + e) << 32 | (ab.surfaceB.firstEdgeKey + f);
+  bodyContacts_.push_back(
+      {p, {1.0f - touch->s, touch->s, touch->t - 1.0f, -touch->t}, 2, key, offset, touch->normal, ab.pair});
 }
 
 // By the leader, after the other contacts: each contact's plane, then its friction.

@@ -1,13 +1,14 @@
-// Body contact's pieces (sim/body_contact.h, sim/spatial_hash.h): the contact plane of a vertex and
-// a triangle, one projection and its friction, and the broad phase's hash, each against geometry
-// worked out by hand.
+// Body contact's pieces (sim/body_contact.h, sim/surface_tree.h): the contact plane of a vertex and
+// a triangle, one projection and its friction, and the broad phase's tree and normal cones, each
+// against geometry worked out by hand or against brute force.
 
 #include <gtest/gtest.h>
 
+#include <map>
 #include <random>
 
 #include "vrdeform/sim/body_contact.h"
-#include "vrdeform/sim/spatial_hash.h"
+#include "vrdeform/sim/surface_tree.h"
 
 namespace vrd {
 namespace {
@@ -123,27 +124,170 @@ TEST(BodyContactProjection, FrictionSticksInsideTheConeAndSlidesOnItsEdge) {
   EXPECT_LT(slide.x(), 0.0f);
 }
 
-TEST(SpatialHash, QueriesFindEveryOverlappingBox) {
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<float> at(-1.0f, 1.0f), size(0.0f, 0.2f);
+// Triangles of their own corners (none shared) with random boxes: each triangle spans its box's
+// diagonal, the rest shape is where they are.
+struct LooseTriangles {
+  std::vector<Triangle> triangles;
+  std::vector<Vec3> rest;
   std::vector<Box3f> boxes;
+};
+LooseTriangles randomTriangles(std::mt19937& rng, int count) {
+  std::uniform_real_distribution<float> at(-1.0f, 1.0f), size(0.0f, 0.2f);
+  LooseTriangles s;
+  for (int k = 0; k < count; ++k) {
+    const Vec3 lo(at(rng), at(rng), at(rng)), hi = lo + Vec3(size(rng), size(rng), size(rng));
+    s.triangles.push_back({Index(3 * k), Index(3 * k + 1), Index(3 * k + 2)});
+    s.rest.insert(s.rest.end(), {lo, hi, Vec3(lo.x(), hi.y(), lo.z())});
+    s.boxes.emplace_back(lo, hi);
+  }
+  return s;
+}
+
+TEST(SurfaceTree, PairsOfTwoTreesAreEveryOverlappingPairOnce) {
+  std::mt19937 rng(7);
+  const LooseTriangles a = randomTriangles(rng, 300), b = randomTriangles(rng, 200);
+  const std::vector<Vec3> up(300, Vec3::UnitZ());  // between two surfaces the cones play no part
+  SurfaceTree ta, tb;
+  ta.build(a.triangles, a.rest);
+  tb.build(b.triangles, b.rest);
+  ta.refit(a.boxes, up, up);
+  tb.refit(b.boxes, std::span(up).first(200), std::span(up).first(200));
+  std::map<std::pair<Index, Index>, int> found;
+  ta.pairsWith(tb, [&](Index t, Index u) { ++found[{t, u}]; });
+  std::size_t overlapping = 0;
+  for (Index t = 0; t < a.boxes.size(); ++t)
+    for (Index u = 0; u < b.boxes.size(); ++u)
+      if (a.boxes[t].intersects(b.boxes[u])) {
+        ++overlapping;
+        EXPECT_EQ((found[{t, u}]), 1) << t << ", " << u;
+      }
+  EXPECT_EQ(found.size(), overlapping);  // nothing that does not overlap
+  EXPECT_GT(overlapping, 20u);
+}
+
+TEST(SurfaceTree, SelfPairsWithoutAFlatPatchAreEveryOverlappingPairOnce) {
+  std::mt19937 rng(11);
+  const LooseTriangles s = randomTriangles(rng, 400);
+  const std::vector<Vec3> normals(s.boxes.size(), Vec3::Zero());  // degenerate: no cone faces one way
+  SurfaceTree tree;
+  tree.build(s.triangles, s.rest);
+  tree.refit(s.boxes, normals, normals);
+  for (const bool closed : {false, true}) {
+    std::map<std::pair<Index, Index>, int> found;
+    tree.selfPairs(closed, [&](Index t, Index u) { ++found[{std::min(t, u), std::max(t, u)}]; });
+    std::size_t overlapping = 0;
+    for (Index t = 0; t < s.boxes.size(); ++t)
+      for (Index u = t + 1; u < s.boxes.size(); ++u)
+        if (s.boxes[t].intersects(s.boxes[u])) {
+          ++overlapping;
+          EXPECT_EQ((found[{t, u}]), 1) << t << ", " << u;
+        }
+    EXPECT_EQ(found.size(), overlapping);
+  }
+}
+
+// Two sheets of 2 x n x n triangles 1 mm apart (boxes grown by a skin), side by side at rest: the
+// upper sheet facing down onto the lower (`fold`, as a fold brings them), or facing up as the
+// lower does (two sheets stacked the same way up).
+struct Layers {
+  std::vector<Triangle> triangles;
+  std::vector<Vec3> rest;
+  std::vector<Box3f> boxes;
+  std::vector<Vec3> normals;
+  std::vector<int> layer;
+};
+Layers twoLayers(bool fold) {
+  constexpr int n = 16;
+  Layers s;
+  for (int i = 0; i <= 2 * n + 1; ++i)  // columns n and n + 1 both at x = n: the sheets' edges
+    for (int j = 0; j <= n; ++j) s.rest.emplace_back(float(i - (i > n ? 1 : 0)) / n, float(j) / n, 0.0f);
+  const auto corner = [&](int i, int j) { return Index(i * (n + 1) + j); };
+  for (int i = 0; i <= 2 * n; ++i)
+    for (int j = 0; j < n; ++j) {
+      if (i == n) continue;                                            // between the sheets
+      const int side = i < n ? 0 : 1, at = side == 0 ? i : 2 * n - i;  // the upper sheet's x, folded over
+      const Vec3 lo(float(at) / n, float(j) / n, side * 0.001f - 0.0006f);
+      for (const Triangle& t : {Triangle{corner(i, j), corner(i + 1, j), corner(i + 1, j + 1)},
+                                Triangle{corner(i, j), corner(i + 1, j + 1), corner(i, j + 1)}}) {
+        s.triangles.push_back(t);
+        s.boxes.emplace_back(lo, lo + Vec3(1.0f / n, 1.0f / n, 0.0012f));
+        s.normals.push_back(Vec3(0.0f, 0.0f, side == 1 && fold ? -1.0f : 1.0f));
+        s.layer.push_back(side);
+      }
+    }
+  return s;
+}
+
+std::size_t overlapsAcross(const Layers& s) {
+  std::size_t count = 0;
+  for (std::size_t t = 0; t < s.boxes.size(); ++t)
+    for (std::size_t u = 0; u < s.boxes.size(); ++u)
+      count += s.layer[t] == 0 && s.layer[u] == 1 && s.boxes[t].intersects(s.boxes[u]) ? 1 : 0;
+  return count;
+}
+
+TEST(SurfaceTree, SelfPairsSkipPatchesThatFaceOneWayAndFindAFold) {
+  const Layers s = twoLayers(true);
+  SurfaceTree tree;
+  tree.build(s.triangles, s.rest);
+  tree.refit(s.boxes, s.normals, s.normals);
+  std::size_t within = 0, across = 0;
+  tree.selfPairs(true, [&](Index t, Index u) { ++(s.layer[t] == s.layer[u] ? within : across); });
+  EXPECT_EQ(within, 0u);  // each sheet faces one way
+  EXPECT_EQ(across, overlapsAcross(s));
+  EXPECT_GT(across, 0u);
+}
+
+// Closed surfaces facing the same way cannot touch from outside (one would be inside the other's
+// solid); a cloth's sheets can.
+TEST(SurfaceTree, SheetsFacingTheSameWayMeetOnlyWhenTheyAreCloth) {
+  const Layers s = twoLayers(false);
+  SurfaceTree tree;
+  tree.build(s.triangles, s.rest);
+  tree.refit(s.boxes, s.normals, s.normals);
+  std::size_t closed = 0, cloth = 0;
+  tree.selfPairs(true, [&](Index, Index) { ++closed; });
+  tree.selfPairs(false, [&](Index t, Index u) { cloth += s.layer[t] != s.layer[u] ? 1 : 0; });
+  EXPECT_EQ(closed, 0u);
+  EXPECT_EQ(cloth, overlapsAcross(s));
+}
+
+TEST(NormalCone, AMergedConeHoldsEveryNormalOfBoth) {
+  std::mt19937 rng(3);
+  std::normal_distribution<float> g;
+  std::uniform_real_distribution<float> angle(0.0f, 1.5f);
+  const auto inside = [](const NormalCone& c, const Vec3& n) {
+    return std::acos(std::clamp(c.axis.dot(n), -1.0f, 1.0f)) <= std::acos(c.cos) + 1e-4f;
+  };
   for (int k = 0; k < 500; ++k) {
-    const Vec3 lo(at(rng), at(rng), at(rng));
-    boxes.emplace_back(lo, lo + Vec3(size(rng), size(rng), size(rng)));
+    // Each cone's rim: a normal at its angle from the axis, in a random direction.
+    std::array<NormalCone, 2> c;
+    std::array<Vec3, 2> rim;
+    for (int s = 0; s < 2; ++s) {
+      const float a = angle(rng);
+      c[s] = {Vec3(g(rng), g(rng), g(rng)).normalized(), std::cos(a), std::sin(a)};
+      const Vec3 across = c[s].axis.cross(Vec3(g(rng), g(rng), g(rng))).normalized();
+      rim[s] = c[s].cos * c[s].axis + c[s].sin * across;
+    }
+    const NormalCone m = merge(c[0], c[1]);
+    EXPECT_NEAR(m.axis.norm(), 1.0f, 1e-5f);
+    for (int s = 0; s < 2; ++s) {
+      EXPECT_TRUE(inside(m, c[s].axis)) << k;
+      EXPECT_TRUE(inside(m, rim[s])) << k;
+    }
+    EXPECT_NEAR(m.cos * m.cos + m.sin * m.sin, 1.0f, 1e-5f);
+    EXPECT_EQ(faceOneWay(c[0], c[1]), facesOneWay(m)) << k;
+    EXPECT_GE(m.sin, 0.0f);
   }
-  const float inf = std::numeric_limits<float>::infinity();
-  boxes.emplace_back(Vec3(-inf, 0.0f, 0.0f), Vec3(inf, 0.0f, 0.0f));      // unbounded: on the list
-  boxes.emplace_back(Vec3(-5.0f, -5.0f, -5.0f), Vec3(5.0f, 5.0f, 5.0f));  // too many cells: on the list
-  SpatialHash hash;
-  hash.build(boxes, 0.1f);
-  for (int q = 0; q < 200; ++q) {
-    const Vec3 lo(at(rng), at(rng), at(rng));
-    const Box3f box(lo, lo + Vec3(size(rng), size(rng), size(rng)));
-    std::vector<char> found(boxes.size(), 0);
-    hash.query(box, [&](Index item) { found[item] = 1; });
-    for (std::size_t k = 0; k < boxes.size(); ++k)
-      EXPECT_TRUE(found[k] || !boxes[k].intersects(box)) << "box " << k << " missed by query " << q;
-  }
+  const auto one = [](const Vec3& n) { return coneOf(std::span(&n, 1)); };
+  EXPECT_FALSE(faceOneWay(one(Vec3::UnitZ()), one(-Vec3::UnitZ())));  // opposite faces
+  EXPECT_TRUE(faceOneWay(one(Vec3::UnitZ()), one(Vec3::UnitX())));    // a convex edge
+  // A cube's corner faces one way; with a face turned against it (a corner pressing into a face) not.
+  const std::vector<Vec3> corner{Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
+  EXPECT_TRUE(facesOneWay(coneOf(corner)));
+  EXPECT_FALSE(faceOneWay(coneOf(corner), one(-Vec3(1.0f, 1.0f, 1.0f).normalized())));
+  EXPECT_FALSE(facesOneWay(one(Vec3(0.0f, std::nanf(""), 0.0f))));  // degenerate: open
+  EXPECT_FALSE(faceOneWay(coneOf(corner), one(Vec3::Zero())));
 }
 
 }  // namespace

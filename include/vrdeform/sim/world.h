@@ -16,7 +16,7 @@
 #include "vrdeform/sim/body_contact.h"
 #include "vrdeform/sim/contact.h"
 #include "vrdeform/sim/solver_settings.h"
-#include "vrdeform/sim/spatial_hash.h"
+#include "vrdeform/sim/surface_tree.h"
 
 namespace vrd {
 
@@ -197,8 +197,11 @@ class World {
                               std::vector<FingertipContact>& fingertipContacts) const;
   void detectTriangleContacts();
   void detectBodyContacts();
-  void detectVertexTriangle(BodyId a, BodyId b);                         // a's vertices against b's triangles
-  void detectEdgeEdge(BodyId a, BodyId b);                               // a's edges against b's
+  struct ContactSides;  // two bodies' frames and settings, for the narrow phase
+  ContactSides contactSides(BodyId a, BodyId b) const;
+  void detectTrianglePair(const ContactSides& ab, Index t, Index u);                // a's triangle t against b's u
+  void detectVertexTriangle(const ContactSides& ab, Index vertex, Index triangle);  // a's vertex, b's triangle
+  void detectEdgeEdge(const ContactSides& ab, Index e, Index f);                    // a's edge, b's edge
   bool touching(BodyId a, BodyId b) const;                               // the pair's settings let them touch
   Box3f sweptBox(Index particle, const Vec3& offset, float grow) const;  // start to prediction, grown
   void solveBodyContacts(float invH);
@@ -258,6 +261,11 @@ class World {
     std::vector<std::array<Index, 2>> edges;      // its edges (body-local, lower first, ascending)
     std::vector<std::array<Index, 2>> edgeFaces;  // per edge, its surface triangles (kNoFace: none)
     static constexpr Index kNoFace = ~Index(0);
+    // Each vertex and edge belongs to one of its triangles (the first), whose pairs find it:
+    // triangle t's are ownedVertices[vertexStart[t], vertexStart[t + 1]) (positions in `vertices`),
+    // and likewise its edges (positions in `edges`).
+    std::vector<Index> vertexStart, ownedVertices, edgeStart, ownedEdges;
+    SurfaceTree tree;                              // over the triangles, built on the rest shape
     Index firstTriangleKey = 0, firstEdgeKey = 0;  // world-wide numbers of its first triangle and edge
   };
   static ContactSurface contactSurfaceOf(const BodyModel& model);
@@ -268,21 +276,16 @@ class World {
   std::vector<BodyContact> bodyContacts_;
   std::vector<float> bodyContactLambda_;
   std::vector<Vec3> bodyContactFrictionLambda_;
-  // The broad phase of each body that takes part: its surface triangles' and edges' swept boxes in
-  // the frame of the first such body, their bounds, and spatial hashes of them.
+  // The broad phase of each body that takes part: its surface features' swept boxes in the frame
+  // of the first such body, and its triangles' normals (the tree's cones and the creases).
   struct ContactBroadPhase {
-    std::vector<Box3f> boxes;      // per surface triangle
-    std::vector<Box3f> edgeBoxes;  // per surface edge
-    std::vector<char> sharp;       // per surface edge of a body in self-contact: a crease (markCreases)
-    std::vector<Vec3> normals;     // markCreases' scratch: per surface triangle
-    Box3f bounds;
-    Vec3 offset;           // the body's frame to the common one
-    SpatialHash hash;      // of the triangles
-    SpatialHash edgeHash;  // of the edges
+    std::vector<Box3f> boxes;                    // per surface triangle
+    std::vector<Box3f> vertexBoxes, edgeBoxes;   // per surface vertex and edge
+    std::vector<Vec3> startNormals, endNormals;  // per surface triangle, at the substep's start and predicted
+    std::vector<char> sharp;                     // per surface edge of a body in self-contact: a crease
+    Vec3 offset;                                 // the body's frame to the common one
   };
   std::vector<ContactBroadPhase> broadPhases_;  // per body
-  std::vector<std::uint32_t> seen_;             // per triangle or edge of a body: the last query that met it
-  std::uint32_t contactQuery_ = 0;
   // The last substep's contacts, whose multipliers a warm start carries over.
   std::vector<ColliderContact> previousColliderContacts_;
   std::vector<FingertipContact> previousFingertipContacts_;

@@ -1,0 +1,123 @@
+#pragma once
+// The broad phase of body contact: a bounding-volume hierarchy over one body's surface triangles,
+// built once on the rest shape and refitted every substep to the triangles' swept boxes, with a
+// cone bounding each node's face normals (Volino and Magnenat-Thalmann 1994, Provot 1997).
+//
+// A node's cone holds the normals of its triangles and of every triangle around their corners, at
+// the substep's start and at the prediction. Where one cone narrower than 90 degrees (a direction
+// with every normal on its positive side) holds two patches of a closed surface, they cannot touch
+// without one being inside the solid already: a vertex resting on a face from outside has a face
+// around it turned against that face's normal, and so does an edge. So the self-traversal of a
+// closed surface (a soft body's) skips every node and every pair of nodes that one such cone
+// holds: a body's smooth stretches cost nothing, and only patches that face each other are tested
+// by their boxes. A cloth is two-sided (a fold lays a sheet on a sheet facing the same way), and
+// two bodies' surfaces are tested by their boxes alone.
+
+#include <span>
+#include <vector>
+
+#include "vrdeform/math/types.h"
+#include "vrdeform/mesh/tet_mesh.h"
+
+namespace vrd {
+
+using Box3f = Eigen::AlignedBox<float, 3>;
+
+/// The directions within an angle of the unit `axis`, kept as its cosine and sine (no trigonometry
+/// in the tests); the full sphere where no direction has every normal on its positive side, or a
+/// normal is degenerate.
+struct NormalCone {
+  Vec3 axis = Vec3::UnitZ();
+  float cos = 1.0f, sin = 0.0f;
+};
+/// A cone around the unit normals' mean direction holding them all; a normal that is not unit (a
+/// degenerate triangle's), normals that cancel, or none give the full sphere.
+NormalCone coneOf(std::span<const Vec3> normals);
+/// A cone holding both (the angle between the axes plus the two angles, halved, where neither
+/// holds the other).
+NormalCone merge(const NormalCone& a, const NormalCone& b);
+/// Whether every normal in the cone is within 90 degrees of its axis.
+inline bool facesOneWay(const NormalCone& c) { return c.cos > 0.0f; }
+/// Whether one cone that faces one way holds both: each does, and the angle between their axes
+/// plus their two angles is under 180 degrees.
+inline bool faceOneWay(const NormalCone& a, const NormalCone& b) {
+  return a.cos > 0.0f && b.cos > 0.0f && a.axis.dot(b.axis) > a.sin * b.sin - a.cos * b.cos;
+}
+
+class SurfaceTree {
+ public:
+  /// The hierarchy over the triangles, by median splits of their rest centres along the widest
+  /// axis. Only the boxes and cones change afterwards.
+  void build(std::span<const Triangle> triangles, std::span<const Vec3> rest);
+
+  /// Each node's box from `boxes` and its normal cone from both sets of unit normals (per
+  /// triangle: at the substep's start and at the prediction; none: every cone the full sphere).
+  void refit(std::span<const Box3f> boxes, std::span<const Vec3> startNormals, std::span<const Vec3> endNormals);
+
+  const Box3f& bounds() const { return nodes_.front().box; }
+  bool empty() const { return nodes_.empty(); }
+
+  /// visit(t, u) once for every pair of two triangles of this surface whose boxes overlap, but
+  /// those the cones rule out (see above; `closed`: a closed surface).
+  template <typename Visit>
+  void selfPairs(bool closed, Visit&& visit) const {
+    if (!nodes_.empty()) self(0, closed, visit);
+  }
+
+  /// visit(t, u) for every triangle t of this surface and u of `other` whose boxes overlap.
+  template <typename Visit>
+  void pairsWith(const SurfaceTree& other, Visit&& visit) const {
+    if (!nodes_.empty() && !other.nodes_.empty()) across(other, 0, 0, false, visit);
+  }
+
+ private:
+  struct Node {
+    Box3f box;
+    NormalCone cone;
+    Index first = 0;  ///< leaf: first entry in items_; inner node: right child (left is the next node)
+    Index count = 0;  ///< triangles in a leaf, 0 for an inner node
+  };
+  Index build(Index begin, Index end, std::span<const Vec3> centres, int depth);
+
+  template <typename Visit>
+  void self(Index n, bool closed, Visit& visit) const {
+    const Node& node = nodes_[n];
+    if (closed && facesOneWay(node.cone)) return;
+    if (node.count > 0) {
+      for (Index i = node.first; i < node.first + node.count; ++i)
+        for (Index j = i + 1; j < node.first + node.count; ++j)
+          if (boxes_[i].intersects(boxes_[j])) visit(items_[i], items_[j]);
+      return;
+    }
+    self(n + 1, closed, visit);
+    self(node.first, closed, visit);
+    across(*this, n + 1, node.first, closed, visit);
+  }
+
+  template <typename Visit>
+  void across(const SurfaceTree& other, Index n, Index m, bool closed, Visit& visit) const {
+    const Node &a = nodes_[n], &b = other.nodes_[m];
+    if (!a.box.intersects(b.box) || (closed && faceOneWay(a.cone, b.cone))) return;
+    if (a.count > 0 && b.count > 0) {
+      for (Index i = a.first; i < a.first + a.count; ++i)
+        for (Index j = b.first; j < b.first + b.count; ++j)
+          if (boxes_[i].intersects(other.boxes_[j])) visit(items_[i], other.items_[j]);
+    } else if (b.count > 0 || (a.count == 0 && a.box.volume() >= b.box.volume())) {  // open the bigger
+      across(other, n + 1, m, closed, visit);
+      across(other, a.first, m, closed, visit);
+    } else {
+      across(other, n, m + 1, closed, visit);
+      across(other, n, b.first, closed, visit);
+    }
+  }
+
+  std::vector<Node> nodes_;
+  std::vector<Index> items_;  ///< triangles in leaf order
+  std::vector<Box3f> boxes_;  ///< per entry of items_: its triangle's box (leaf order, for the scans)
+  /// Per node: the triangles whose normals its cone holds (a leaf's triangles and those around
+  /// their corners) are around_[aroundStart_[n], aroundStart_[n + 1]); none for an inner node.
+  std::vector<Index> aroundStart_, around_;
+  std::vector<Vec3> scratch_;  ///< refit's: one leaf's normals
+};
+
+}  // namespace vrd
