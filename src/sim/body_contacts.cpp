@@ -1,5 +1,5 @@
 // The world's contact between bodies and of a body with itself (body_contact.h): settings,
-// detection with a spatial hash over the surfaces' swept boxes, the projection and readouts.
+// detection through each surface's tree of swept boxes (surface_tree.h), the projection and readouts.
 
 #include <fmt/format.h>
 
