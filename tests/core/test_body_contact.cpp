@@ -226,11 +226,16 @@ std::size_t overlapsAcross(const Layers& s) {
   return count;
 }
 
-TEST(SurfaceTree, SelfPairsSkipPatchesThatFaceOneWayAndFindAFold) {
-  const Layers s = twoLayers(true);
+SurfaceTree treeOf(const Layers& s) {
   SurfaceTree tree;
   tree.build(s.triangles, s.rest);
   tree.refit(s.boxes, s.normals, s.normals);
+  return tree;
+}
+
+TEST(SurfaceTree, SelfPairsSkipPatchesThatFaceOneWayAndFindAFold) {
+  const Layers s = twoLayers(true);
+  const SurfaceTree tree = treeOf(s);
   std::size_t within = 0, across = 0;
   tree.selfPairs(true, [&](Index t, Index u) { ++(s.layer[t] == s.layer[u] ? within : across); });
   EXPECT_EQ(within, 0u);  // each sheet faces one way
@@ -242,9 +247,7 @@ TEST(SurfaceTree, SelfPairsSkipPatchesThatFaceOneWayAndFindAFold) {
 // solid); a cloth's sheets can.
 TEST(SurfaceTree, SheetsFacingTheSameWayMeetOnlyWhenTheyAreCloth) {
   const Layers s = twoLayers(false);
-  SurfaceTree tree;
-  tree.build(s.triangles, s.rest);
-  tree.refit(s.boxes, s.normals, s.normals);
+  const SurfaceTree tree = treeOf(s);
   std::size_t closed = 0, cloth = 0;
   tree.selfPairs(true, [&](Index, Index) { ++closed; });
   tree.selfPairs(false, [&](Index t, Index u) { cloth += s.layer[t] != s.layer[u] ? 1 : 0; });

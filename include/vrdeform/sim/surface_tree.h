@@ -54,9 +54,6 @@ class SurfaceTree {
   /// triangle: at the substep's start and at the prediction; none: every cone the full sphere).
   void refit(std::span<const Box3f> boxes, std::span<const Vec3> startNormals, std::span<const Vec3> endNormals);
 
-  const Box3f& bounds() const { return nodes_.front().box; }
-  bool empty() const { return nodes_.empty(); }
-
   /// visit(t, u) once for every pair of two triangles of this surface whose boxes overlap, but
   /// those the cones rule out (see above; `closed`: a closed surface).
   template <typename Visit>

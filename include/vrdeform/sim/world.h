@@ -265,7 +265,7 @@ class World {
     // triangle t's are ownedVertices[vertexStart[t], vertexStart[t + 1]) (positions in `vertices`),
     // and likewise its edges (positions in `edges`).
     std::vector<Index> vertexStart, ownedVertices, edgeStart, ownedEdges;
-    SurfaceTree tree;                              // over the triangles, built on the rest shape
+    SurfaceTree tree;                              // over the triangles: built on the rest shape, refitted each substep
     Index firstTriangleKey = 0, firstEdgeKey = 0;  // world-wide numbers of its first triangle and edge
   };
   static ContactSurface contactSurfaceOf(const BodyModel& model);
@@ -277,7 +277,7 @@ class World {
   std::vector<float> bodyContactLambda_;
   std::vector<Vec3> bodyContactFrictionLambda_;
   // The broad phase of each body that takes part: its surface features' swept boxes in the frame
-  // of the first such body, and its triangles' normals (the tree's cones and the creases).
+  // of the first such body, and, in self-contact, its triangles' normals (the tree's cones, the creases).
   struct ContactBroadPhase {
     std::vector<Box3f> boxes;                    // per surface triangle
     std::vector<Box3f> vertexBoxes, edgeBoxes;   // per surface vertex and edge
