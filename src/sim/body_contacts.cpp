@@ -190,8 +190,8 @@ void World::detectBodyContacts() {
     for (std::size_t y = x; y < taking.size(); ++y) {
       const BodyId a = taking[x], b = taking[y];
       if (!touching(a, b)) continue;
-      const ContactSides ab = contactSides(a, b);
-      const auto meet = [&](Index t, Index u) { detectTrianglePair(ab, t, u); };
+      const ContactSides ab = contactSides(a, b), ba = ab.swapped();
+      const auto meet = [&](Index t, Index u) { detectTrianglePair(ab, ba, t, u); };
       if (a == b)
         contactSurfaces_[a].tree.selfPairs(!bodies_[a].model->tets.empty(), meet);  // a soft body's surface is closed
       else
@@ -221,12 +221,11 @@ void World::markCreases(BodyId id) {
   }
 }
 
-// Triangle t of a and u of b (boxes overlapping): each one's vertices against the other, and
-// their edges against each other's.
-void World::detectTrianglePair(const ContactSides& ab, Index t, Index u) {
+// Triangle t of a and u of b (boxes overlapping; ba: the sides swapped): each one's vertices
+// against the other, and their edges against each other's.
+void World::detectTrianglePair(const ContactSides& ab, const ContactSides& ba, Index t, Index u) {
   const ContactSurface &sa = ab.surfaceA, &sb = ab.surfaceB;
   for (Index k = sa.vertexStart[t]; k < sa.vertexStart[t + 1]; ++k) detectVertexTriangle(ab, sa.ownedVertices[k], u);
-  const ContactSides ba = ab.swapped();
   for (Index k = sb.vertexStart[u]; k < sb.vertexStart[u + 1]; ++k) detectVertexTriangle(ba, sb.ownedVertices[k], t);
   for (Index k = sa.edgeStart[t]; k < sa.edgeStart[t + 1]; ++k)
     for (Index l = sb.edgeStart[u]; l < sb.edgeStart[u + 1]; ++l)
@@ -277,13 +276,10 @@ void World::detectVertexTriangle(const ContactSides& ab, Index vertex, Index t) 
 // self-contact only pairs with a crease (markCreases), each from its lower edge: the same contact
 // (key, corner order) from every substep, for the warm start.
 void World::detectEdgeEdge(const ContactSides& ab, Index e, Index f) {
-  if (!ab.broadA.edgeBoxes[e].intersects(ab.broadB.edgeBoxes[f])) return;
   const bool self = ab.a == ab.b;
-  if (self) {
-    const std::vector<char>& sharp = ab.broadA.sharp;
-    if (!sharp.empty() && !sharp[e] && !sharp[f]) return;
-    if (f < e) std::swap(e, f);
-  }
+  if (self && !ab.broadA.sharp.empty() && !ab.broadA.sharp[e] && !ab.broadA.sharp[f]) return;
+  if (!ab.broadA.edgeBoxes[e].intersects(ab.broadB.edgeBoxes[f])) return;
+  if (self && f < e) std::swap(e, f);
   const Point* const pred = predicted_.data();
   const Point* const start = local_.data();
   const std::array<Index, 2>&edge = ab.surfaceA.edges[e], &g = ab.surfaceB.edges[f];

@@ -199,7 +199,7 @@ class World {
   void detectBodyContacts();
   struct ContactSides;  // two bodies' frames and settings, for the narrow phase
   ContactSides contactSides(BodyId a, BodyId b) const;
-  void detectTrianglePair(const ContactSides& ab, Index t, Index u);                // a's triangle t against b's u
+  void detectTrianglePair(const ContactSides& ab, const ContactSides& ba, Index t, Index u);  // a's t, b's u
   void detectVertexTriangle(const ContactSides& ab, Index vertex, Index triangle);  // a's vertex, b's triangle
   void detectEdgeEdge(const ContactSides& ab, Index e, Index f);                    // a's edge, b's edge
   bool touching(BodyId a, BodyId b) const;                               // the pair's settings let them touch
