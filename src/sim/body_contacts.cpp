@@ -86,6 +86,11 @@ World::ContactSurface World::contactSurfaceOf(const BodyModel& model) {
       surface.ownedVertices);
   own([&](std::size_t k) { return surface.edgeFaces[k][0]; }, surface.edges.size(), surface.edgeStart,
       surface.ownedEdges);
+  for (const Triangle& t : model.surface)
+    surface.triangleCorners.push_back(
+        {position(surface.vertices, t[0]), position(surface.vertices, t[1]), position(surface.vertices, t[2])});
+  for (const std::array<Index, 2>& e : surface.edges)
+    surface.edgeCorners.push_back({position(surface.vertices, e[0]), position(surface.vertices, e[1])});
   surface.tree.build(model.surface, model.restPositions);
   return surface;
 }
@@ -166,23 +171,23 @@ void World::detectBodyContacts() {
     ContactBroadPhase& broad = broadPhases_[id];
     broad.offset = offsetBetween(b, bodies_[taking.front()]);
     const float grow = 2.0f * bodyContactSettings_[id].thickness;
-    const auto swept = [&](Index v) { return sweptBox(b.firstParticle + v, broad.offset, grow); };
+    broad.vertexBoxes.clear();
+    for (Index v : surface.vertices) broad.vertexBoxes.push_back(sweptBox(b.firstParticle + v, broad.offset, grow));
+    const std::vector<Box3f>& at = broad.vertexBoxes;  // the triangles' and edges' boxes from their corners'
     broad.boxes.clear();
+    for (const std::array<Index, 3>& c : surface.triangleCorners)
+      broad.boxes.push_back(at[c[0]].merged(at[c[1]]).merged(at[c[2]]));
+    broad.edgeBoxes.clear();
+    for (const std::array<Index, 2>& c : surface.edgeCorners) broad.edgeBoxes.push_back(at[c[0]].merged(at[c[1]]));
     broad.startNormals.clear();
     broad.endNormals.clear();
-    const bool self = bodyContactSettings_[id].self;  // the normals serve self-contact only
-    for (const Triangle& t : b.model->surface) {
-      broad.boxes.push_back(swept(t[0]).extend(swept(t[1])).extend(swept(t[2])));
-      if (!self) continue;
-      const Index i = b.firstParticle;
-      broad.startNormals.push_back(faceNormal(local_[i + t[0]].pos, local_[i + t[1]].pos, local_[i + t[2]].pos));
-      broad.endNormals.push_back(
-          faceNormal(predicted_[i + t[0]].pos, predicted_[i + t[1]].pos, predicted_[i + t[2]].pos));
-    }
-    broad.vertexBoxes.clear();
-    for (Index v : surface.vertices) broad.vertexBoxes.push_back(swept(v));
-    broad.edgeBoxes.clear();
-    for (const std::array<Index, 2>& e : surface.edges) broad.edgeBoxes.push_back(swept(e[0]).extend(swept(e[1])));
+    if (bodyContactSettings_[id].self)  // the normals serve self-contact only
+      for (const Triangle& t : b.model->surface) {
+        const Index i = b.firstParticle;
+        broad.startNormals.push_back(faceNormal(local_[i + t[0]].pos, local_[i + t[1]].pos, local_[i + t[2]].pos));
+        broad.endNormals.push_back(
+            faceNormal(predicted_[i + t[0]].pos, predicted_[i + t[1]].pos, predicted_[i + t[2]].pos));
+      }
     markCreases(id);
     surface.tree.refit(broad.boxes, broad.startNormals, broad.endNormals);
   }

@@ -265,6 +265,8 @@ class World {
     // triangle t's are ownedVertices[vertexStart[t], vertexStart[t + 1]) (positions in `vertices`),
     // and likewise its edges (positions in `edges`).
     std::vector<Index> vertexStart, ownedVertices, edgeStart, ownedEdges;
+    std::vector<std::array<Index, 3>> triangleCorners;  // each triangle's corners, as positions in `vertices`
+    std::vector<std::array<Index, 2>> edgeCorners;      // each edge's, likewise
     SurfaceTree tree;                              // over the triangles: built on the rest shape, refitted each substep
     Index firstTriangleKey = 0, firstEdgeKey = 0;  // world-wide numbers of its first triangle and edge
   };
