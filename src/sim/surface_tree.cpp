@@ -10,20 +10,20 @@ namespace {
 
 constexpr Index kLeafSize = 4;
 constexpr float kPi = std::numbers::pi_v<float>;
+const NormalCone kSphere{Vec3::UnitZ(), -1.0f, 0.0f};  // holds every direction
 
 float angleBetween(const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.dot(b), -1.0f, 1.0f)); }
 
 }  // namespace
 
 NormalCone coneOf(std::span<const Vec3> normals) {
-  const NormalCone sphere{Vec3::UnitZ(), -1.0f, 0.0f};
   Vec3 sum = Vec3::Zero();
   for (const Vec3& n : normals) {
-    if (!(std::abs(n.squaredNorm() - 1.0f) < 1e-3f)) return sphere;  // a degenerate triangle's
+    if (!(std::abs(n.squaredNorm() - 1.0f) < 1e-3f)) return kSphere;  // a degenerate triangle's
     sum += n;
   }
   const float length = sum.norm();
-  if (!(length > 1e-6f)) return sphere;
+  if (!(length > 1e-6f)) return kSphere;
   const Vec3 axis = sum / length;
   float cosine = 1.0f;
   for (const Vec3& n : normals) cosine = std::min(cosine, axis.dot(n));
@@ -36,7 +36,7 @@ NormalCone merge(const NormalCone& a, const NormalCone& b) {
   if (between + angleB <= angleA) return a;
   if (between + angleA <= angleB) return b;
   const float angle = 0.5f * (between + angleA + angleB);
-  if (!(angle < kPi)) return {a.axis, -1.0f, 0.0f};
+  if (!(angle < kPi)) return kSphere;
   // The axis turned from a's towards b's by (angle - angleA), in their plane.
   const float turn = angle - angleA;
   const Vec3 axis =
@@ -104,7 +104,7 @@ void SurfaceTree::refit(std::span<const Box3f> boxes, std::span<const Vec3> star
     if (node.count == 0) {
       const Node &left = nodes_[n + 1], &right = nodes_[node.first];
       node.box = left.box.merged(right.box);
-      node.cone = merge(left.cone, right.cone);
+      node.cone = startNormals.empty() ? kSphere : merge(left.cone, right.cone);
       continue;
     }
     node.box = boxes_[node.first];
