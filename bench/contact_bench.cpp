@@ -1,8 +1,9 @@
 // Body contact benchmarks (Google Benchmark), each with its baseline in the same run:
 //  - SelfContact/tets/self: a 10 x 10 x 20 cm block of {1k, 10k, 100k} tets pinned at one end and
 //    sagging (the paper's constraint set, 5 iterations, 1 substep), self-contact off (the baseline)
-//    and on. Counters: the surface's triangles, and the detection and body-contact solve times per
-//    step (StepReport stage times), so that detection's growth with the surface shows in one table.
+//    and on. Counters: the surface's triangles, the detection and body-contact solve times per step
+//    (StepReport stage times), so that detection's growth with the surface shows in one table, and
+//    the contacts a step: found, and pushed (a non-zero multiplier).
 //  - SelfContactEightSubsteps/tets/self: the 10k block at 8 substeps of 1/480 s (the scene files'
 //    default) instead of one.
 //  - Stack/tets: two such blocks, one resting on the other, contact between them on and off.
@@ -33,13 +34,14 @@ constexpr int kSteps = 60;
 void timeSteps(benchmark::State& state, World& world, std::size_t triangles) {
   for (int s = 0; s < 10; ++s) world.step();
   double detect = 0.0, solve = 0.0;
-  std::size_t contacts = 0;
+  std::size_t contacts = 0, pushed = 0;
   float deepest = 0.0f;
   for (auto _ : state) {
     world.step();
     detect += world.lastStep().times.ms[std::size_t(Stage::Detect)];
     solve += world.lastStep().times.ms[std::size_t(Stage::BodyContact)];
     contacts += world.bodyContacts().size();
+    pushed += world.lastStep().bodyContacts;
     deepest = std::max(deepest, world.lastStep().deepestPenetration);
   }
   const double n = double(state.iterations());
@@ -47,6 +49,7 @@ void timeSteps(benchmark::State& state, World& world, std::size_t triangles) {
   state.counters["detect_ms"] = detect / n;
   state.counters["contact_solve_ms"] = solve / n;
   state.counters["contacts"] = double(contacts) / n;
+  state.counters["pushed"] = double(pushed) / n;
   state.counters["deepest_mm"] = 1e3 * double(deepest);
 }
 

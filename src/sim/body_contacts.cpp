@@ -179,6 +179,10 @@ void World::detectBodyContacts() {
       broad.boxes.push_back(at[c[0]].merged(at[c[1]]).merged(at[c[2]]));
     broad.edgeBoxes.clear();
     for (const std::array<Index, 2>& c : surface.edgeCorners) broad.edgeBoxes.push_back(at[c[0]].merged(at[c[1]]));
+    broad.moving.clear();
+    for (const Triangle& t : b.model->surface)
+      broad.moving.push_back(
+          std::any_of(t.begin(), t.end(), [&](Index v) { return predicted_[b.firstParticle + v].w > 0.0f; }));
     broad.startNormals.clear();
     broad.endNormals.clear();
     if (bodyContactSettings_[id].self)  // the normals serve self-contact only
@@ -189,7 +193,7 @@ void World::detectBodyContacts() {
             faceNormal(predicted_[i + t[0]].pos, predicted_[i + t[1]].pos, predicted_[i + t[2]].pos));
       }
     markCreases(id);
-    surface.tree.refit(broad.boxes, broad.startNormals, broad.endNormals);
+    surface.tree.refit(broad.boxes, broad.startNormals, broad.endNormals, broad.moving);
   }
   for (std::size_t x = 0; x < taking.size(); ++x)
     for (std::size_t y = x; y < taking.size(); ++y) {

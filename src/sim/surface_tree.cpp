@@ -2,48 +2,38 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <numeric>
 
 namespace vrd {
 namespace {
 
 constexpr Index kLeafSize = 4;
-constexpr float kPi = std::numbers::pi_v<float>;
 const NormalCone kSphere{Vec3::UnitZ(), -1.0f, 0.0f};  // holds every direction
-
-float angleBetween(const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.dot(b), -1.0f, 1.0f)); }
 
 }  // namespace
 
-NormalCone coneOf(std::span<const Vec3> normals) {
-  Vec3 sum = Vec3::Zero();
-  for (const Vec3& n : normals) {
-    if (!(std::abs(n.squaredNorm() - 1.0f) < 1e-3f)) return kSphere;  // a degenerate triangle's
-    sum += n;
-  }
-  const float length = sum.norm();
-  if (!(length > 1e-6f)) return kSphere;
-  const Vec3 axis = sum / length;
+NormalCone coneAbout(const Vec3& axis, std::span<const Index> triangles, std::span<const Vec3> startNormals,
+                     std::span<const Vec3> endNormals) {
   float cosine = 1.0f;
-  for (const Vec3& n : normals) cosine = std::min(cosine, axis.dot(n));
-  cosine = std::max(cosine, -1.0f);
+  for (Index t : triangles)
+    for (const Vec3* n : {&startNormals[t], &endNormals[t]}) {
+      const float d = axis.dot(*n);
+      if (!(d >= cosine)) cosine = d;  // also a NaN
+    }
+  if (!(cosine > -1.0f && axis.allFinite())) return kSphere;
   return {axis, cosine, std::sqrt(1.0f - cosine * cosine)};
 }
 
-NormalCone merge(const NormalCone& a, const NormalCone& b) {
-  const float between = angleBetween(a.axis, b.axis), angleA = std::acos(a.cos), angleB = std::acos(b.cos);
-  if (between + angleB <= angleA) return a;
-  if (between + angleA <= angleB) return b;
-  const float angle = 0.5f * (between + angleA + angleB);
-  if (!(angle < kPi)) return kSphere;
-  // The axis turned from a's towards b's by (angle - angleA), in their plane.
-  const float turn = angle - angleA;
-  const Vec3 axis =
-      between < 1e-6f
-          ? a.axis
-          : Vec3((std::sin(between - turn) * a.axis + std::sin(turn) * b.axis) / std::sin(between)).normalized();
-  return {axis, std::cos(angle), std::sin(angle)};
+NormalCone enclosing(const Vec3& axis, const NormalCone& a, const NormalCone& b) {
+  NormalCone cone{axis, 1.0f, 0.0f};
+  for (const NormalCone* c : {&a, &b}) {
+    const float cosine = axis.dot(c->axis), sine = axis.cross(c->axis).norm();
+    const float sum = sine * c->cos + cosine * c->sin;  // the sine of the angle from the axis to c's rim
+    if (!(sum >= 0.0f)) return kSphere;                 // past 180 degrees
+    const float rim = cosine * c->cos - sine * c->sin;
+    if (rim < cone.cos) cone = {axis, rim, sum};
+  }
+  return cone;
 }
 
 void SurfaceTree::build(std::span<const Triangle> triangles, std::span<const Vec3> rest) {
@@ -97,24 +87,35 @@ Index SurfaceTree::build(Index begin, Index end, std::span<const Vec3> centres, 
 
 // Children come after their parent, so one backward pass sees both children of a node before it.
 void SurfaceTree::refit(std::span<const Box3f> boxes, std::span<const Vec3> startNormals,
-                        std::span<const Vec3> endNormals) {
+                        std::span<const Vec3> endNormals, std::span<const std::uint8_t> moving) {
   for (std::size_t k = 0; k < items_.size(); ++k) boxes_[k] = boxes[items_[k]];
   for (std::size_t n = nodes_.size(); n-- > 0;) {
     Node& node = nodes_[n];
     if (node.count == 0) {
       const Node &left = nodes_[n + 1], &right = nodes_[node.first];
       node.box = left.box.merged(right.box);
-      node.cone = startNormals.empty() ? kSphere : merge(left.cone, right.cone);
+      node.still = left.still && right.still;
+      const Vec3 sum = left.cone.axis + right.cone.axis;
+      node.cone = startNormals.empty() || !(sum.squaredNorm() > 1e-12f)
+                      ? kSphere
+                      : enclosing(sum.normalized(), left.cone, right.cone);
       continue;
     }
     node.box = boxes_[node.first];
-    for (Index k = node.first; k < node.first + node.count; ++k) node.box.extend(boxes_[k]);
-    scratch_.clear();
-    for (Index k = aroundStart_[n]; k < aroundStart_[n + 1] && !startNormals.empty(); ++k) {
-      scratch_.push_back(startNormals[around_[k]]);
-      scratch_.push_back(endNormals[around_[k]]);
+    node.still = true;
+    for (Index k = node.first; k < node.first + node.count; ++k) {
+      node.box.extend(boxes_[k]);
+      node.still = node.still && !moving.empty() && !moving[items_[k]];
     }
-    node.cone = coneOf(scratch_);
+    if (startNormals.empty()) {
+      node.cone = kSphere;
+      continue;
+    }
+    // About the normals' mean direction.
+    const std::span<const Index> around(around_.data() + aroundStart_[n], around_.data() + aroundStart_[n + 1]);
+    Vec3 sum = Vec3::Zero();
+    for (Index t : around) sum += startNormals[t] + endNormals[t];
+    node.cone = sum.norm() > 1e-6f ? coneAbout(sum.normalized(), around, startNormals, endNormals) : kSphere;
   }
 }
 

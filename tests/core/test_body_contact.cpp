@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <numeric>
 #include <random>
 
 #include "vrdeform/sim/body_contact.h"
@@ -150,8 +151,8 @@ TEST(SurfaceTree, PairsOfTwoTreesAreEveryOverlappingPairOnce) {
   SurfaceTree ta, tb;
   ta.build(a.triangles, a.rest);
   tb.build(b.triangles, b.rest);
-  ta.refit(a.boxes, up, up);
-  tb.refit(b.boxes, std::span(up).first(200), std::span(up).first(200));
+  ta.refit(a.boxes, up, up, {});
+  tb.refit(b.boxes, std::span(up).first(200), std::span(up).first(200), {});
   std::map<std::pair<Index, Index>, int> found;
   ta.pairsWith(tb, [&](Index t, Index u) { ++found[{t, u}]; });
   std::size_t overlapping = 0;
@@ -165,13 +166,47 @@ TEST(SurfaceTree, PairsOfTwoTreesAreEveryOverlappingPairOnce) {
   EXPECT_GT(overlapping, 20u);
 }
 
+// Triangles that do not move (every corner kinematic) never touch each other: nodes of them alone
+// are skipped, every overlapping pair with a moving triangle is still found once.
+TEST(SurfaceTree, PairsOfTrianglesThatDoNotMoveAreSkipped) {
+  std::mt19937 rng(5);
+  const LooseTriangles a = randomTriangles(rng, 300), b = randomTriangles(rng, 300);
+  const std::vector<Vec3> up(300, Vec3::UnitZ());
+  std::vector<std::uint8_t> movingA(300, 0), movingB(300, 0);
+  for (std::size_t t = 0; t < 300; ++t) movingA[t] = a.rest[3 * t].x() > 0.5f ? 1 : 0;  // a patch of a moves
+  SurfaceTree ta, tb;
+  ta.build(a.triangles, a.rest);
+  tb.build(b.triangles, b.rest);
+  ta.refit(a.boxes, up, up, movingA);
+  tb.refit(b.boxes, up, up, movingB);
+  std::map<std::pair<Index, Index>, int> found;
+  ta.pairsWith(tb, [&](Index t, Index u) { ++found[{t, u}]; });
+  std::size_t moving = 0, still = 0;
+  for (Index t = 0; t < 300; ++t)
+    for (Index u = 0; u < 300; ++u) {
+      if (!a.boxes[t].intersects(b.boxes[u])) continue;
+      if (movingA[t]) {
+        ++moving;
+        EXPECT_EQ((found[{t, u}]), 1) << t << ", " << u;
+      } else {
+        still += found.count({t, u});
+      }
+    }
+  EXPECT_GT(moving, 5u);
+  EXPECT_LT(still, moving);  // only where a leaf mixes moving and still triangles
+  std::size_t none = 0;
+  tb.pairsWith(tb, [&](Index, Index) { ++none; });
+  tb.selfPairs(false, [&](Index, Index) { ++none; });
+  EXPECT_EQ(none, 0u);
+}
+
 TEST(SurfaceTree, SelfPairsWithoutAFlatPatchAreEveryOverlappingPairOnce) {
   std::mt19937 rng(11);
   const LooseTriangles s = randomTriangles(rng, 400);
   const std::vector<Vec3> normals(s.boxes.size(), Vec3::Zero());  // degenerate: no cone faces one way
   SurfaceTree tree;
   tree.build(s.triangles, s.rest);
-  tree.refit(s.boxes, normals, normals);
+  tree.refit(s.boxes, normals, normals, {});
   for (const bool closed : {false, true}) {
     std::map<std::pair<Index, Index>, int> found;
     tree.selfPairs(closed, [&](Index t, Index u) { ++found[{std::min(t, u), std::max(t, u)}]; });
@@ -229,7 +264,7 @@ std::size_t overlapsAcross(const Layers& s) {
 SurfaceTree treeOf(const Layers& s) {
   SurfaceTree tree;
   tree.build(s.triangles, s.rest);
-  tree.refit(s.boxes, s.normals, s.normals);
+  tree.refit(s.boxes, s.normals, s.normals, {});
   return tree;
 }
 
@@ -255,7 +290,16 @@ TEST(SurfaceTree, SheetsFacingTheSameWayMeetOnlyWhenTheyAreCloth) {
   EXPECT_EQ(cloth, overlapsAcross(s));
 }
 
-TEST(NormalCone, AMergedConeHoldsEveryNormalOfBoth) {
+// The cone about the normals' mean direction.
+NormalCone coneOf(std::span<const Vec3> normals) {
+  std::vector<Index> all(normals.size());
+  std::iota(all.begin(), all.end(), Index{0});
+  Vec3 sum = Vec3::Zero();
+  for (const Vec3& n : normals) sum += n;
+  return coneAbout(sum.normalized(), all, normals, normals);
+}
+
+TEST(NormalCone, AnEnclosingConeHoldsEveryNormalOfBoth) {
   std::mt19937 rng(3);
   std::normal_distribution<float> g;
   std::uniform_real_distribution<float> angle(0.0f, 1.5f);
@@ -266,21 +310,29 @@ TEST(NormalCone, AMergedConeHoldsEveryNormalOfBoth) {
     // Each cone's rim: a normal at its angle from the axis, in a random direction.
     std::array<NormalCone, 2> c;
     std::array<Vec3, 2> rim;
+    const float equal = angle(rng);
     for (int s = 0; s < 2; ++s) {
-      const float a = angle(rng);
+      const float a = k % 2 == 0 ? equal : angle(rng);
       c[s] = {Vec3(g(rng), g(rng), g(rng)).normalized(), std::cos(a), std::sin(a)};
       const Vec3 across = c[s].axis.cross(Vec3(g(rng), g(rng), g(rng))).normalized();
       rim[s] = c[s].cos * c[s].axis + c[s].sin * across;
     }
-    const NormalCone m = merge(c[0], c[1]);
-    EXPECT_NEAR(m.axis.norm(), 1.0f, 1e-5f);
-    for (int s = 0; s < 2; ++s) {
-      EXPECT_TRUE(inside(m, c[s].axis)) << k;
-      EXPECT_TRUE(inside(m, rim[s])) << k;
+    // About the bisector of the axes, and about any axis.
+    const NormalCone m = enclosing((c[0].axis + c[1].axis).normalized(), c[0], c[1]);
+    const NormalCone any = enclosing(Vec3(g(rng), g(rng), g(rng)).normalized(), c[0], c[1]);
+    for (const NormalCone& e : {m, any}) {
+      for (int s = 0; s < 2; ++s) {
+        EXPECT_TRUE(inside(e, c[s].axis)) << k;
+        EXPECT_TRUE(inside(e, rim[s])) << k;
+      }
+      EXPECT_NEAR(e.cos * e.cos + e.sin * e.sin, 1.0f, 1e-5f);
+      EXPECT_GE(e.sin, 0.0f);
+      EXPECT_TRUE(!facesOneWay(e) || faceOneWay(c[0], c[1])) << k;  // never narrower than both
     }
-    EXPECT_NEAR(m.cos * m.cos + m.sin * m.sin, 1.0f, 1e-5f);
-    EXPECT_EQ(faceOneWay(c[0], c[1]), facesOneWay(m)) << k;
-    EXPECT_GE(m.sin, 0.0f);
+    // Two cones of one angle: the bisector is the narrowest axis, the same test as the pair's.
+    if (k % 2 == 0) {
+      EXPECT_EQ(faceOneWay(c[0], c[1]), facesOneWay(m)) << k;
+    }
   }
   const auto one = [](const Vec3& n) { return coneOf(std::span(&n, 1)); };
   EXPECT_FALSE(faceOneWay(one(Vec3::UnitZ()), one(-Vec3::UnitZ())));  // opposite faces
@@ -288,9 +340,15 @@ TEST(NormalCone, AMergedConeHoldsEveryNormalOfBoth) {
   // A cube's corner faces one way; with a face turned against it (a corner pressing into a face) not.
   const std::vector<Vec3> corner{Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
   EXPECT_TRUE(facesOneWay(coneOf(corner)));
+  EXPECT_NEAR(coneOf(corner).cos, 1.0f / std::sqrt(3.0f), 1e-6f);
   EXPECT_FALSE(faceOneWay(coneOf(corner), one(-Vec3(1.0f, 1.0f, 1.0f).normalized())));
-  EXPECT_FALSE(facesOneWay(one(Vec3(0.0f, std::nanf(""), 0.0f))));  // degenerate: open
-  EXPECT_FALSE(faceOneWay(coneOf(corner), one(Vec3::Zero())));
+  // Degenerate: open.
+  EXPECT_FALSE(facesOneWay(one(Vec3(0.0f, std::nanf(""), 0.0f))));
+  const std::vector<Vec3> withNaN{Vec3::UnitX(), Vec3(std::nanf(""), 0.0f, 0.0f)};
+  const std::vector<Index> both{0, 1};
+  EXPECT_EQ(coneAbout(Vec3::UnitX(), both, withNaN, withNaN).cos, -1.0f);
+  const std::vector<Vec3> withZero{Vec3::UnitX(), Vec3::Zero()};
+  EXPECT_FALSE(facesOneWay(coneAbout(Vec3::UnitX(), both, withZero, withZero)));
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 // by their boxes. A cloth is two-sided (a fold lays a sheet on a sheet facing the same way), and
 // two bodies' surfaces are tested by their boxes alone.
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -30,12 +31,14 @@ struct NormalCone {
   Vec3 axis = Vec3::UnitZ();
   float cos = 1.0f, sin = 0.0f;
 };
-/// A cone around the unit normals' mean direction holding them all; a normal that is not unit (a
-/// degenerate triangle's), normals that cancel, or none give the full sphere.
-NormalCone coneOf(std::span<const Vec3> normals);
-/// A cone holding both (the angle between the axes plus the two angles, halved, where neither
-/// holds the other).
-NormalCone merge(const NormalCone& a, const NormalCone& b);
+/// The cone about the unit `axis` holding both unit normals of every listed triangle (per triangle:
+/// at the substep's start and at the prediction); a normal that is not finite gives the full
+/// sphere, a zero one (a degenerate triangle's) a cone of at least 90 degrees.
+NormalCone coneAbout(const Vec3& axis, std::span<const Index> triangles, std::span<const Vec3> startNormals,
+                     std::span<const Vec3> endNormals);
+/// The cone about the unit `axis` holding both cones (each one's angle from the axis plus its own,
+/// added as cosines and sines: no trigonometry).
+NormalCone enclosing(const Vec3& axis, const NormalCone& a, const NormalCone& b);
 /// Whether every normal in the cone is within 90 degrees of its axis.
 inline bool facesOneWay(const NormalCone& c) { return c.cos > 0.0f; }
 /// Whether one cone that faces one way holds both: each does, and the angle between their axes
@@ -50,9 +53,11 @@ class SurfaceTree {
   /// axis. Only the boxes and cones change afterwards.
   void build(std::span<const Triangle> triangles, std::span<const Vec3> rest);
 
-  /// Each node's box from `boxes` and its normal cone from both sets of unit normals (per
-  /// triangle: at the substep's start and at the prediction; none: every cone the full sphere).
-  void refit(std::span<const Box3f> boxes, std::span<const Vec3> startNormals, std::span<const Vec3> endNormals);
+  /// Each node's box from `boxes`, its normal cone from both sets of unit normals (per triangle:
+  /// at the substep's start and at the prediction; none: every cone the full sphere), and whether
+  /// none of its triangles moves (per triangle, whether a corner does: two such nodes never touch).
+  void refit(std::span<const Box3f> boxes, std::span<const Vec3> startNormals, std::span<const Vec3> endNormals,
+             std::span<const std::uint8_t> moving);
 
   /// visit(t, u) once for every pair of two triangles of this surface whose boxes overlap, but
   /// those the cones rule out (see above; `closed`: a closed surface).
@@ -71,15 +76,16 @@ class SurfaceTree {
   struct Node {
     Box3f box;
     NormalCone cone;
-    Index first = 0;  ///< leaf: first entry in items_; inner node: right child (left is the next node)
-    Index count = 0;  ///< triangles in a leaf, 0 for an inner node
+    bool still = false;  ///< none of its triangles moves
+    Index first = 0;     ///< leaf: first entry in items_; inner node: right child (left is the next node)
+    Index count = 0;     ///< triangles in a leaf, 0 for an inner node
   };
   Index build(Index begin, Index end, std::span<const Vec3> centres, int depth);
 
   template <typename Visit>
   void self(Index n, bool closed, Visit& visit) const {
     const Node& node = nodes_[n];
-    if (closed && facesOneWay(node.cone)) return;
+    if (node.still || (closed && facesOneWay(node.cone))) return;
     if (node.count > 0) {
       for (Index i = node.first; i < node.first + node.count; ++i)
         for (Index j = i + 1; j < node.first + node.count; ++j)
@@ -94,7 +100,7 @@ class SurfaceTree {
   template <typename Visit>
   void across(const SurfaceTree& other, Index n, Index m, bool closed, Visit& visit) const {
     const Node &a = nodes_[n], &b = other.nodes_[m];
-    if (!a.box.intersects(b.box) || (closed && faceOneWay(a.cone, b.cone))) return;
+    if ((a.still && b.still) || !a.box.intersects(b.box) || (closed && faceOneWay(a.cone, b.cone))) return;
     if (a.count > 0 && b.count > 0) {
       for (Index i = a.first; i < a.first + a.count; ++i)
         for (Index j = b.first; j < b.first + b.count; ++j)
@@ -114,7 +120,6 @@ class SurfaceTree {
   /// Per node: the triangles whose normals its cone holds (a leaf's triangles and those around
   /// their corners) are around_[aroundStart_[n], aroundStart_[n + 1]); none for an inner node.
   std::vector<Index> aroundStart_, around_;
-  std::vector<Vec3> scratch_;  ///< refit's: one leaf's normals
 };
 
 }  // namespace vrd

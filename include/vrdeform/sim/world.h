@@ -285,6 +285,7 @@ class World {
     std::vector<Box3f> vertexBoxes, edgeBoxes;   // per surface vertex and edge
     std::vector<Vec3> startNormals, endNormals;  // per surface triangle, at the substep's start and predicted
     std::vector<char> sharp;                     // per surface edge of a body in self-contact: a crease
+    std::vector<std::uint8_t> moving;            // per surface triangle: whether a corner moves
     Vec3 offset;                                 // the body's frame to the common one
   };
   std::vector<ContactBroadPhase> broadPhases_;  // per body
