@@ -8,6 +8,7 @@
 #include <numeric>
 #include <span>
 
+#include "solver_team.h"
 #include "vrdeform/error.h"
 #include "vrdeform/sim/world.h"
 
@@ -119,12 +120,13 @@ struct World::ContactSides {
   const ContactBroadPhase &broadA, &broadB;
   Vec3 offsetBA, offsetAB;  // b's frame to a's, and back
   ContactPair pair;
+  std::vector<BodyContact>& found;  // where the contacts go
   ContactSides swapped() const {
-    return {b, a, bodyB, bodyA, surfaceB, surfaceA, broadB, broadA, offsetAB, offsetBA, pair};
+    return {b, a, bodyB, bodyA, surfaceB, surfaceA, broadB, broadA, offsetAB, offsetBA, pair, found};
   }
 };
 
-World::ContactSides World::contactSides(BodyId a, BodyId b) const {
+World::ContactSides World::contactSides(BodyId a, BodyId b, std::vector<BodyContact>& found) const {
   return {a,
           b,
           bodies_[a],
@@ -135,7 +137,8 @@ World::ContactSides World::contactSides(BodyId a, BodyId b) const {
           broadPhases_[b],
           offsetBetween(bodies_[b], bodies_[a]),
           offsetBetween(bodies_[a], bodies_[b]),
-          contactPair(bodyContactSettings_[a], bodyContactSettings_[b])};
+          contactPair(bodyContactSettings_[a], bodyContactSettings_[b]),
+          found};
 }
 
 // Each substep, from the positions at its start and the predictions: each body's surface tree is
@@ -153,77 +156,128 @@ World::ContactSides World::contactSides(BodyId a, BodyId b) const {
 // gap of each other in the rest shape (not all the features around a vertex: where a surface
 // wrinkles under compression, its faces two apart are the ones that cross), and on a closed
 // surface the edge pairs without a crease (markCreases).
-void World::detectBodyContacts() {
+// A team shares the work: each member makes its share of every surface's vertex boxes and
+// normals, then its share of the trees' parts (their triangles' boxes, the refit) and of the
+// edges, then takes pairs of parts to traverse as it comes free; the leader joins the contacts.
+// Contacts are sorted by their keys, so the team finds the one-thread list.
+void World::detectBodyContacts(const SolverTeam& team) {
+  if (contactBodies_.empty()) return;
+  for (BodyId id : contactBodies_) {
+    const Body& b = bodies_[id];
+    const Index first = b.firstParticle;
+    const ContactSurface& surface = contactSurfaces_[id];
+    ContactBroadPhase& broad = broadPhases_[id];
+    const float grow = 2.0f * bodyContactSettings_[id].thickness;
+    const auto [v0, v1] = team.share(0, surface.vertices.size(), 64);
+    for (std::size_t k = v0; k < v1; ++k)
+      broad.vertexBoxes[k] = sweptBox(first + surface.vertices[k], broad.offset, grow);
+    const auto [t0, t1] = team.share(0, surface.triangleCorners.size(), 64);
+    for (std::size_t k = t0; k < t1; ++k) {
+      const Triangle& t = b.model->surface[k];
+      broad.moving[k] = std::any_of(t.begin(), t.end(), [&](Index v) { return predicted_[first + v].w > 0.0f; });
+      if (broad.startNormals.empty()) continue;  // the normals serve self-contact only
+      broad.startNormals[k] = faceNormal(local_[first + t[0]].pos, local_[first + t[1]].pos, local_[first + t[2]].pos);
+      broad.endNormals[k] =
+          faceNormal(predicted_[first + t[0]].pos, predicted_[first + t[1]].pos, predicted_[first + t[2]].pos);
+    }
+  }
+  team.barrier();
+  // The triangles' and edges' boxes from their corners'.
+  const auto [p0, p1] = team.share(0, contactParts_.size(), 1);
+  for (std::size_t k = p0; k < p1; ++k) {
+    const auto [id, part] = contactParts_[k];
+    ContactSurface& surface = contactSurfaces_[id];
+    ContactBroadPhase& broad = broadPhases_[id];
+    const std::vector<Box3f>& at = broad.vertexBoxes;
+    for (Index t : surface.tree.partTriangles(part)) {
+      const std::array<Index, 3>& c = surface.triangleCorners[t];
+      broad.boxes[t] = at[c[0]].merged(at[c[1]]).merged(at[c[2]]);
+    }
+    surface.tree.refitPart(part, {broad.boxes, broad.startNormals, broad.endNormals, broad.moving});
+  }
+  for (BodyId id : contactBodies_) {
+    const ContactSurface& surface = contactSurfaces_[id];
+    ContactBroadPhase& broad = broadPhases_[id];
+    const auto [e0, e1] = team.share(0, surface.edges.size(), 64);
+    for (std::size_t e = e0; e < e1; ++e) {
+      const std::array<Index, 2>& c = surface.edgeCorners[e];
+      broad.edgeBoxes[e] = broad.vertexBoxes[c[0]].merged(broad.vertexBoxes[c[1]]);
+    }
+    markCreases(id, e0, e1);
+  }
+  std::vector<BodyContact>& found = team.leader() ? bodyContacts_ : memberContacts_[std::size_t(team.index)].body;
+  found.clear();
+  team.shareOut(contactTasks_.size(), [&](std::size_t k) {
+    const ContactTask& task = contactTasks_[k];
+    const ContactSides ab = contactSides(task.a, task.b, found), ba = ab.swapped();
+    const auto meet = [&](Index t, Index u) { detectTrianglePair(ab, ba, t, u); };
+    const SurfaceTree& tree = contactSurfaces_[task.a].tree;
+    if (task.a == task.b)
+      tree.selfPairs(!bodies_[task.a].model->tets.empty(), task.i, task.j, meet);  // a soft body's surface is closed
+    else
+      tree.pairsWith(contactSurfaces_[task.b].tree, task.i, task.j, meet);
+  });
+  team.barrier();
+  if (!team.leader()) return;
+  for (int k = 1; k < team.size; ++k) {
+    const std::vector<BodyContact>& other = memberContacts_[std::size_t(k)].body;
+    bodyContacts_.insert(bodyContacts_.end(), other.begin(), other.end());
+  }
+  // The order the warm start matches contacts in (and the one-thread order).
+  std::sort(bodyContacts_.begin(), bodyContacts_.end(),
+            [](const BodyContact& x, const BodyContact& y) { return x.key < y.key; });
+}
+
+// By the leader before detection: the bodies that touch something (themselves, or another active
+// body with a surface), their broad phases sized and framed, and the work: the parts of their
+// trees, and the pairs of parts of the pairs of bodies that touch.
+void World::prepareBodyContacts() {
   bodyContacts_.clear();
-  // The bodies that touch something: themselves, or another active body with a surface.
-  std::vector<BodyId> candidates, taking;
+  contactBodies_.clear();
+  contactParts_.clear();
+  contactTasks_.clear();
+  std::vector<BodyId> candidates;
   for (BodyId id = 0; id < bodies_.size(); ++id)
     if (bodies_[id].state == BodyState::Active && !bodies_[id].model->surface.empty()) candidates.push_back(id);
   for (BodyId a : candidates)
     if (std::any_of(candidates.begin(), candidates.end(), [&](BodyId b) { return touching(a, b); }))
-      taking.push_back(a);
-  if (taking.empty()) return;
-
+      contactBodies_.push_back(a);
   broadPhases_.resize(bodies_.size());
-  for (BodyId id : taking) {
-    const Body& b = bodies_[id];
-    ContactSurface& surface = contactSurfaces_[id];
+  for (BodyId id : contactBodies_) {
+    const ContactSurface& surface = contactSurfaces_[id];
     ContactBroadPhase& broad = broadPhases_[id];
-    broad.offset = offsetBetween(b, bodies_[taking.front()]);
-    const float grow = 2.0f * bodyContactSettings_[id].thickness;
-    broad.vertexBoxes.clear();
-    for (Index v : surface.vertices) broad.vertexBoxes.push_back(sweptBox(b.firstParticle + v, broad.offset, grow));
-    const std::vector<Box3f>& at = broad.vertexBoxes;  // the triangles' and edges' boxes from their corners'
-    broad.boxes.clear();
-    for (const std::array<Index, 3>& c : surface.triangleCorners)
-      broad.boxes.push_back(at[c[0]].merged(at[c[1]]).merged(at[c[2]]));
-    broad.edgeBoxes.clear();
-    for (const std::array<Index, 2>& c : surface.edgeCorners) broad.edgeBoxes.push_back(at[c[0]].merged(at[c[1]]));
-    broad.moving.clear();
-    for (const Triangle& t : b.model->surface)
-      broad.moving.push_back(
-          std::any_of(t.begin(), t.end(), [&](Index v) { return predicted_[b.firstParticle + v].w > 0.0f; }));
-    broad.startNormals.clear();
-    broad.endNormals.clear();
-    if (bodyContactSettings_[id].self)  // the normals serve self-contact only
-      for (const Triangle& t : b.model->surface) {
-        const Index i = b.firstParticle;
-        broad.startNormals.push_back(faceNormal(local_[i + t[0]].pos, local_[i + t[1]].pos, local_[i + t[2]].pos));
-        broad.endNormals.push_back(
-            faceNormal(predicted_[i + t[0]].pos, predicted_[i + t[1]].pos, predicted_[i + t[2]].pos));
-      }
-    markCreases(id);
-    surface.tree.refit(broad.boxes, broad.startNormals, broad.endNormals, broad.moving);
+    broad.offset = offsetBetween(bodies_[id], bodies_[contactBodies_.front()]);
+    const bool self = bodyContactSettings_[id].self;
+    broad.vertexBoxes.resize(surface.vertices.size());
+    broad.boxes.resize(surface.triangleCorners.size());
+    broad.edgeBoxes.resize(surface.edges.size());
+    broad.moving.resize(surface.triangleCorners.size());
+    broad.startNormals.resize(self ? surface.triangleCorners.size() : 0);
+    broad.endNormals.resize(broad.startNormals.size());
+    broad.sharp.resize(self && !bodies_[id].model->tets.empty() ? surface.edges.size() : 0);
+    for (std::uint32_t p = 0; p < surface.tree.parts(); ++p) contactParts_.push_back({id, p});
   }
-  for (std::size_t x = 0; x < taking.size(); ++x)
-    for (std::size_t y = x; y < taking.size(); ++y) {
-      const BodyId a = taking[x], b = taking[y];
+  for (std::size_t x = 0; x < contactBodies_.size(); ++x)
+    for (std::size_t y = x; y < contactBodies_.size(); ++y) {
+      const BodyId a = contactBodies_[x], b = contactBodies_[y];
       if (!touching(a, b)) continue;
-      const ContactSides ab = contactSides(a, b), ba = ab.swapped();
-      const auto meet = [&](Index t, Index u) { detectTrianglePair(ab, ba, t, u); };
-      if (a == b)
-        contactSurfaces_[a].tree.selfPairs(!bodies_[a].model->tets.empty(), meet);  // a soft body's surface is closed
-      else
-        contactSurfaces_[a].tree.pairsWith(contactSurfaces_[b].tree, meet);
+      const auto parts = [&](BodyId id) { return std::uint32_t(contactSurfaces_[id].tree.parts()); };
+      for (std::uint32_t i = 0; i < parts(a); ++i)
+        for (std::uint32_t j = a == b ? i : 0; j < parts(b); ++j) contactTasks_.push_back({a, b, i, j});
     }
-  // The order the warm start matches contacts in.
-  std::sort(bodyContacts_.begin(), bodyContacts_.end(),
-            [](const BodyContact& x, const BodyContact& y) { return x.key < y.key; });
 }
 
 // Self-contact of a closed surface needs edge pairs only where an edge is a crease: between two
 // smooth stretches of surface a vertex meets the other side's faces before any edge can cross
 // between vertices. Creases from the substep's start (a fold makes new ones), by the angle between
 // the edge's two faces; a boundary edge (a surface that is not closed) counts as one.
-void World::markCreases(BodyId id) {
+// No creases (sharp empty): every edge of a cloth or between bodies.
+void World::markCreases(BodyId id, std::size_t begin, std::size_t end) {
   ContactBroadPhase& broad = broadPhases_[id];
-  broad.sharp.clear();
-  if (!bodyContactSettings_[id].self || bodies_[id].model->tets.empty())
-    return;  // every edge of a cloth or between bodies
+  if (broad.sharp.empty()) return;
   const ContactSurface& surface = contactSurfaces_[id];
   constexpr float kCreaseCos = 0.866f;  // faces more than 30 degrees apart
-  broad.sharp.resize(surface.edges.size());
-  for (std::size_t e = 0; e < surface.edges.size(); ++e) {
+  for (std::size_t e = begin; e < end; ++e) {
     const std::array<Index, 2>& f = surface.edgeFaces[e];
     broad.sharp[e] =
         f[1] == ContactSurface::kNoFace || !(broad.startNormals[f[0]].dot(broad.startNormals[f[1]]) > kCreaseCos);
@@ -232,7 +286,7 @@ void World::markCreases(BodyId id) {
 
 // Triangle t of a and u of b (boxes overlapping; ba: the sides swapped): each one's vertices
 // against the other, and their edges against each other's.
-void World::detectTrianglePair(const ContactSides& ab, const ContactSides& ba, Index t, Index u) {
+void World::detectTrianglePair(const ContactSides& ab, const ContactSides& ba, Index t, Index u) const {
   const ContactSurface &sa = ab.surfaceA, &sb = ab.surfaceB;
   for (Index k = sa.vertexStart[t]; k < sa.vertexStart[t + 1]; ++k) detectVertexTriangle(ab, sa.ownedVertices[k], u);
   for (Index k = sb.vertexStart[u]; k < sb.vertexStart[u + 1]; ++k) detectVertexTriangle(ba, sb.ownedVertices[k], t);
@@ -251,7 +305,7 @@ bool shareCorner(std::span<const Index> f, std::span<const Index> g) {
 }  // namespace
 
 // Surface vertex `vertex` of a (its position in the surface's vertex list) against triangle t of b.
-void World::detectVertexTriangle(const ContactSides& ab, Index vertex, Index t) {
+void World::detectVertexTriangle(const ContactSides& ab, Index vertex, Index t) const {
   if (!ab.broadA.vertexBoxes[vertex].intersects(ab.broadB.boxes[t])) return;
   const Point* const pred = predicted_.data();
   const Point* const start = local_.data();
@@ -277,14 +331,13 @@ void World::detectVertexTriangle(const ContactSides& ab, Index vertex, Index t) 
     if ((rest[v] - (w[0] * rest[tri[0]] + w[1] * rest[tri[1]] + w[2] * rest[tri[2]])).norm() <= gap) return;
   }
   const std::uint64_t key = std::uint64_t(i) << 32 | (ab.surfaceB.firstTriangleKey + t);
-  bodyContacts_.push_back(
-      {p, {1.0f, -touch->b[0], -touch->b[1], -touch->b[2]}, 1, key, offset, touch->normal, ab.pair});
+  ab.found.push_back({p, {1.0f, -touch->b[0], -touch->b[1], -touch->b[2]}, 1, key, offset, touch->normal, ab.pair});
 }
 
 // Surface edges e of a and f of b (positions in the surfaces' edge lists). Within a body in
 // self-contact only pairs with a crease (markCreases), each from its lower edge: the same contact
 // (key, corner order) from every substep, for the warm start.
-void World::detectEdgeEdge(const ContactSides& ab, Index e, Index f) {
+void World::detectEdgeEdge(const ContactSides& ab, Index e, Index f) const {
   const bool self = ab.a == ab.b;
   if (self && !ab.broadA.sharp.empty() && !ab.broadA.sharp[e] && !ab.broadA.sharp[f]) return;
   if (!ab.broadA.edgeBoxes[e].intersects(ab.broadB.edgeBoxes[f])) return;
@@ -310,7 +363,7 @@ void World::detectEdgeEdge(const ContactSides& ab, Index e, Index f) {
   }
   const std::uint64_t key =
       1ull << 63 | std::uint64_t(ab.surfaceA.firstEdgeKey + e) << 32 | (ab.surfaceB.firstEdgeKey + f);
-  bodyContacts_.push_back(
+  ab.found.push_back(
       {p, {1.0f - touch->s, touch->s, touch->t - 1.0f, -touch->t}, 2, key, offset, touch->normal, ab.pair});
 }
 

@@ -75,7 +75,7 @@ void ThreadTeam::run(void* job, Invoke invoke) {
   invoke_ = invoke;
   runs_.fetch_add(1, std::memory_order_release);  // publishes the job
   runs_.notify_all();
-  invoke(job, SolverTeam{0, size_, &barrier_});
+  invoke(job, SolverTeam{0, size_, &barrier_, &tickets_});
   barrier_.arriveAndWait();  // every member has finished
 }
 
@@ -85,7 +85,7 @@ void ThreadTeam::work(int index) {
     waitForChange(runs_, seen);
     seen = runs_.load(std::memory_order_acquire);
     if (stopping_) return;
-    invoke_(job_, SolverTeam{index, size_, &barrier_});
+    invoke_(job_, SolverTeam{index, size_, &barrier_, &tickets_});
     barrier_.arriveAndWait();
   }
 }

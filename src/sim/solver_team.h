@@ -50,12 +50,25 @@ struct SolverTeam {
   int index = 0;  ///< this thread's place in the team
   int size = 1;   ///< threads in the team
   TeamBarrier* barrier_ = nullptr;
+  std::atomic<std::size_t>* tickets_ = nullptr;  // shareOut's next item
 
   bool leader() const { return index == 0; }
   bool last() const { return index + 1 == size; }
   /// Waits until every member has reached it; nothing in a team of one.
   void barrier() const {
     if (size > 1) barrier_->arriveAndWait();
+  }
+  /// work(i) for each i in [0, count), handed out one at a time as members come free. Every member
+  /// calls it with the same count; it starts with a barrier, and two calls need a barrier between.
+  template <typename Work>
+  void shareOut(std::size_t count, Work&& work) const {
+    if (size == 1) {
+      for (std::size_t i = 0; i < count; ++i) work(i);
+      return;
+    }
+    if (leader()) tickets_->store(0, std::memory_order_relaxed);  // published by the barrier
+    barrier();
+    for (std::size_t i; (i = tickets_->fetch_add(1, std::memory_order_relaxed)) < count;) work(i);
   }
   /// This member's share of [begin, end), cut at multiples of `align` from begin so that SIMD
   /// batches stay whole.
@@ -122,6 +135,7 @@ class ThreadTeam {
   int size_;
   TeamChoice choice_;
   TeamBarrier barrier_;
+  std::atomic<std::size_t> tickets_{0};
   std::atomic<std::uint32_t> runs_{0};  // bumped to start a run; workers wait for it to change
   bool stopping_ = false;               // read by workers after a change of runs_
   void* job_ = nullptr;

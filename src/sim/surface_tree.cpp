@@ -8,6 +8,7 @@ namespace vrd {
 namespace {
 
 constexpr Index kLeafSize = 4;
+constexpr int kCutDepth = 3;                           // up to 8 parts: work for a few threads, little lost at the cut
 const NormalCone kSphere{Vec3::UnitZ(), -1.0f, 0.0f};  // holds every direction
 
 }  // namespace
@@ -38,6 +39,7 @@ NormalCone enclosing(const Vec3& axis, const NormalCone& a, const NormalCone& b)
 
 void SurfaceTree::build(std::span<const Triangle> triangles, std::span<const Vec3> rest) {
   nodes_.clear();
+  parts_.clear();
   items_.resize(triangles.size());
   boxes_.resize(triangles.size());
   if (triangles.empty()) return;
@@ -70,9 +72,11 @@ Index SurfaceTree::build(Index begin, Index end, std::span<const Vec3> centres, 
   Box3f spread;
   for (Index k = begin; k < end; ++k) spread.extend(centres[items_[k]]);
   // Median splits give depth log2(n / kLeafSize); the cap only keeps the recursion shallow.
+  const auto part = [&] { parts_.push_back({index, Index(nodes_.size()), begin, end}); };
   if (end - begin <= kLeafSize || depth >= 48) {
     nodes_[index].first = begin;
     nodes_[index].count = end - begin;
+    if (depth <= kCutDepth) part();
     return index;
   }
   int axis = 0;
@@ -82,14 +86,16 @@ Index SurfaceTree::build(Index begin, Index end, std::span<const Vec3> centres, 
                    [&](Index a, Index b) { return centres[a][axis] < centres[b][axis]; });
   build(begin, mid, centres, depth + 1);
   nodes_[index].first = build(mid, end, centres, depth + 1);
+  if (depth == kCutDepth) part();
   return index;
 }
 
 // Children come after their parent, so one backward pass sees both children of a node before it.
-void SurfaceTree::refit(std::span<const Box3f> boxes, std::span<const Vec3> startNormals,
-                        std::span<const Vec3> endNormals, std::span<const std::uint8_t> moving) {
-  for (std::size_t k = 0; k < items_.size(); ++k) boxes_[k] = boxes[items_[k]];
-  for (std::size_t n = nodes_.size(); n-- > 0;) {
+void SurfaceTree::refitPart(std::size_t part, const SurfaceFrame& frame) {
+  const Part& p = parts_[part];
+  const auto [boxes, startNormals, endNormals, moving] = frame;
+  for (Index k = p.item; k < p.itemEnd; ++k) boxes_[k] = boxes[items_[k]];
+  for (Index n = p.nodeEnd; n-- > p.node;) {
     Node& node = nodes_[n];
     if (node.count == 0) {
       const Node &left = nodes_[n + 1], &right = nodes_[node.first];

@@ -493,8 +493,9 @@ void World::predict(float h, const SolverTeam& team) {
 // Contacts in particle order (bodies are appended, so their particles come in body order): the
 // team cuts the lists at particle boundaries (solveWorldConstraints). Each member detects its share
 // of the particles into its own lists, and the leader joins them in member order (so in particle
-// order) and finds the triangle contacts; then each member resets its share of the multipliers and
-// goes on to recordSubstepStart, whose barrier closes this.
+// order) and finds the triangle contacts; the team finds the body contacts together; then each
+// member resets its share of the multipliers and goes on to recordSubstepStart, whose barrier
+// closes this.
 void World::detectContacts(const SolverTeam& team) {
   StageTimer timer(report_.times, Stage::Detect, settings_.timeStages && team.leader());
   MemberContacts* const own = team.leader() ? nullptr : &memberContacts_[std::size_t(team.index)];
@@ -509,6 +510,7 @@ void World::detectContacts(const SolverTeam& team) {
   collider.clear();
   fingertip.clear();
   detectParticleContacts(team, collider, fingertip);
+  if (team.leader()) prepareBodyContacts();
   team.barrier();
   if (team.leader()) {
     for (int k = 1; k < team.size; ++k) {
@@ -517,8 +519,8 @@ void World::detectContacts(const SolverTeam& team) {
       fingertipContacts_.insert(fingertipContacts_.end(), other.fingertip.begin(), other.fingertip.end());
     }
     detectTriangleContacts();
-    detectBodyContacts();
   }
+  detectBodyContacts(team);
   resetMultipliers(team);
 }
 

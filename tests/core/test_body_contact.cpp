@@ -144,6 +144,21 @@ LooseTriangles randomTriangles(std::mt19937& rng, int count) {
   return s;
 }
 
+// The whole tree, part by part, as a team's members share it.
+void refit(SurfaceTree& tree, const SurfaceFrame& frame) {
+  for (std::size_t p = 0; p < tree.parts(); ++p) tree.refitPart(p, frame);
+}
+template <typename Visit>
+void pairsOf(const SurfaceTree& a, const SurfaceTree& b, Visit&& visit) {
+  for (std::size_t i = 0; i < a.parts(); ++i)
+    for (std::size_t j = 0; j < b.parts(); ++j) a.pairsWith(b, i, j, visit);
+}
+template <typename Visit>
+void selfPairsOf(const SurfaceTree& tree, bool closed, Visit&& visit) {
+  for (std::size_t i = 0; i < tree.parts(); ++i)
+    for (std::size_t j = i; j < tree.parts(); ++j) tree.selfPairs(closed, i, j, visit);
+}
+
 TEST(SurfaceTree, PairsOfTwoTreesAreEveryOverlappingPairOnce) {
   std::mt19937 rng(7);
   const LooseTriangles a = randomTriangles(rng, 300), b = randomTriangles(rng, 200);
@@ -151,10 +166,11 @@ TEST(SurfaceTree, PairsOfTwoTreesAreEveryOverlappingPairOnce) {
   SurfaceTree ta, tb;
   ta.build(a.triangles, a.rest);
   tb.build(b.triangles, b.rest);
-  ta.refit(a.boxes, up, up, {});
-  tb.refit(b.boxes, std::span(up).first(200), std::span(up).first(200), {});
+  ASSERT_EQ(ta.parts(), 8u);  // cut three levels down
+  refit(ta, {a.boxes, up, up, {}});
+  refit(tb, {b.boxes, std::span(up).first(200), std::span(up).first(200), {}});
   std::map<std::pair<Index, Index>, int> found;
-  ta.pairsWith(tb, [&](Index t, Index u) { ++found[{t, u}]; });
+  pairsOf(ta, tb, [&](Index t, Index u) { ++found[{t, u}]; });
   std::size_t overlapping = 0;
   for (Index t = 0; t < a.boxes.size(); ++t)
     for (Index u = 0; u < b.boxes.size(); ++u)
@@ -177,10 +193,10 @@ TEST(SurfaceTree, PairsOfTrianglesThatDoNotMoveAreSkipped) {
   SurfaceTree ta, tb;
   ta.build(a.triangles, a.rest);
   tb.build(b.triangles, b.rest);
-  ta.refit(a.boxes, up, up, movingA);
-  tb.refit(b.boxes, up, up, movingB);
+  refit(ta, {a.boxes, up, up, movingA});
+  refit(tb, {b.boxes, up, up, movingB});
   std::map<std::pair<Index, Index>, int> found;
-  ta.pairsWith(tb, [&](Index t, Index u) { ++found[{t, u}]; });
+  pairsOf(ta, tb, [&](Index t, Index u) { ++found[{t, u}]; });
   std::size_t moving = 0, still = 0;
   for (Index t = 0; t < 300; ++t)
     for (Index u = 0; u < 300; ++u) {
@@ -195,8 +211,8 @@ TEST(SurfaceTree, PairsOfTrianglesThatDoNotMoveAreSkipped) {
   EXPECT_GT(moving, 5u);
   EXPECT_LT(still, moving);  // only where a leaf mixes moving and still triangles
   std::size_t none = 0;
-  tb.pairsWith(tb, [&](Index, Index) { ++none; });
-  tb.selfPairs(false, [&](Index, Index) { ++none; });
+  pairsOf(tb, tb, [&](Index, Index) { ++none; });
+  selfPairsOf(tb, false, [&](Index, Index) { ++none; });
   EXPECT_EQ(none, 0u);
 }
 
@@ -206,10 +222,10 @@ TEST(SurfaceTree, SelfPairsWithoutAFlatPatchAreEveryOverlappingPairOnce) {
   const std::vector<Vec3> normals(s.boxes.size(), Vec3::Zero());  // degenerate: no cone faces one way
   SurfaceTree tree;
   tree.build(s.triangles, s.rest);
-  tree.refit(s.boxes, normals, normals, {});
+  refit(tree, {s.boxes, normals, normals, {}});
   for (const bool closed : {false, true}) {
     std::map<std::pair<Index, Index>, int> found;
-    tree.selfPairs(closed, [&](Index t, Index u) { ++found[{std::min(t, u), std::max(t, u)}]; });
+    selfPairsOf(tree, closed, [&](Index t, Index u) { ++found[{std::min(t, u), std::max(t, u)}]; });
     std::size_t overlapping = 0;
     for (Index t = 0; t < s.boxes.size(); ++t)
       for (Index u = t + 1; u < s.boxes.size(); ++u)
@@ -264,7 +280,7 @@ std::size_t overlapsAcross(const Layers& s) {
 SurfaceTree treeOf(const Layers& s) {
   SurfaceTree tree;
   tree.build(s.triangles, s.rest);
-  tree.refit(s.boxes, s.normals, s.normals, {});
+  refit(tree, {s.boxes, s.normals, s.normals, {}});
   return tree;
 }
 
@@ -272,7 +288,7 @@ TEST(SurfaceTree, SelfPairsSkipPatchesThatFaceOneWayAndFindAFold) {
   const Layers s = twoLayers(true);
   const SurfaceTree tree = treeOf(s);
   std::size_t within = 0, across = 0;
-  tree.selfPairs(true, [&](Index t, Index u) { ++(s.layer[t] == s.layer[u] ? within : across); });
+  selfPairsOf(tree, true, [&](Index t, Index u) { ++(s.layer[t] == s.layer[u] ? within : across); });
   EXPECT_EQ(within, 0u);  // each sheet faces one way
   EXPECT_EQ(across, overlapsAcross(s));
   EXPECT_GT(across, 0u);
@@ -284,8 +300,8 @@ TEST(SurfaceTree, SheetsFacingTheSameWayMeetOnlyWhenTheyAreCloth) {
   const Layers s = twoLayers(false);
   const SurfaceTree tree = treeOf(s);
   std::size_t closed = 0, cloth = 0;
-  tree.selfPairs(true, [&](Index, Index) { ++closed; });
-  tree.selfPairs(false, [&](Index t, Index u) { cloth += s.layer[t] != s.layer[u] ? 1 : 0; });
+  selfPairsOf(tree, true, [&](Index, Index) { ++closed; });
+  selfPairsOf(tree, false, [&](Index t, Index u) { cloth += s.layer[t] != s.layer[u] ? 1 : 0; });
   EXPECT_EQ(closed, 0u);
   EXPECT_EQ(cloth, overlapsAcross(s));
 }

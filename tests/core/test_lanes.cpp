@@ -458,6 +458,43 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactly) {
   }
 }
 
+// Body contact is found by the team too (each member a share of the boxes, the trees' parts and
+// the pairs of parts): a block in self-contact dropped onto another on the ground gives the
+// one-thread contacts and positions bit for bit.
+TEST(Lanes, ThreadsFindTheOneThreadBodyContacts) {
+  const auto big = dampedBlock(10, {true, true, true, true});
+  const auto drop = [&](int threads) {
+    SolverSettings s;
+    s.substeps = 2;
+    s.threads = threads;
+    s.threadsFallBack = false;
+    World w(s);
+    const BodyId lower = w.addBody(big), upper = w.addBody(big, Vec3(0.01f, 0.102f, 0.0f));
+    w.addCollider(Collider::plane(Vec3::UnitY()));
+    BodyContactSettings contact;
+    contact.self = true;
+    w.setBodyContact(lower, contact);
+    w.setBodyContact(upper, contact);
+    for (Index i = 0; i < big->particleCount(); ++i)
+      w.particles().v[w.particleIndex(upper, i)] = Vec3(0.0f, -0.5f, 0.0f);
+    std::vector<std::vector<std::uint64_t>> keys;
+    for (int step = 0; step < 6; ++step) {
+      w.step();
+      keys.emplace_back();
+      for (const BodyContact& c : w.bodyContacts()) keys.back().push_back(c.key);
+    }
+    return std::pair{w.particles().x, keys};
+  };
+  const auto [one, oneKeys] = drop(1);
+  ASSERT_GT(oneKeys.back().size(), 100u);  // the blocks touch
+  for (int threads : {2, 3}) {
+    const auto [many, manyKeys] = drop(threads);
+    ASSERT_EQ(manyKeys, oneKeys) << threads << " threads";
+    for (std::size_t i = 0; i < one.size(); ++i)
+      ASSERT_EQ(many[i].pos, one[i].pos) << threads << " threads, particle " << i;
+  }
+}
+
 // A world whose steps go to the team or to one thread as TeamChoice decides (here: as its
 // settings say, step by step) still gives the one-thread result bit for bit.
 TEST(Lanes, SwitchingBetweenTheTeamAndOneThreadKeepsTheResult) {

@@ -12,6 +12,9 @@
 // holds: a body's smooth stretches cost nothing, and only patches that face each other are tested
 // by their boxes. A cloth is two-sided (a fold lays a sheet on a sheet facing the same way), and
 // two bodies' surfaces are tested by their boxes alone.
+//
+// The tree is cut into parts (the subtrees a few levels down) that a team of threads refits and
+// traverses side by side: each part, and each pair of parts, is a piece of work of its own.
 
 #include <cstdint>
 #include <span>
@@ -47,29 +50,46 @@ inline bool faceOneWay(const NormalCone& a, const NormalCone& b) {
   return a.cos > 0.0f && b.cos > 0.0f && a.axis.dot(b.axis) > a.sin * b.sin - a.cos * b.cos;
 }
 
+/// What a refit reads, per triangle: its box, its unit normals at the substep's start and at the
+/// prediction (none: every cone the full sphere), and whether a corner moves (none: every one does).
+struct SurfaceFrame {
+  std::span<const Box3f> boxes;
+  std::span<const Vec3> startNormals, endNormals;
+  std::span<const std::uint8_t> moving;
+};
+
 class SurfaceTree {
  public:
   /// The hierarchy over the triangles, by median splits of their rest centres along the widest
   /// axis. Only the boxes and cones change afterwards.
   void build(std::span<const Triangle> triangles, std::span<const Vec3> rest);
 
-  /// Each node's box from `boxes`, its normal cone from both sets of unit normals (per triangle:
-  /// at the substep's start and at the prediction; none: every cone the full sphere), and whether
-  /// none of its triangles moves (per triangle, whether a corner does: two such nodes never touch).
-  void refit(std::span<const Box3f> boxes, std::span<const Vec3> startNormals, std::span<const Vec3> endNormals,
-             std::span<const std::uint8_t> moving);
-
-  /// visit(t, u) once for every pair of two triangles of this surface whose boxes overlap, but
-  /// those the cones rule out (see above; `closed`: a closed surface).
-  template <typename Visit>
-  void selfPairs(bool closed, Visit&& visit) const {
-    if (!nodes_.empty()) self(0, closed, visit);
+  /// The parts the tree is cut into, and the triangles of each.
+  std::size_t parts() const { return parts_.size(); }
+  std::span<const Index> partTriangles(std::size_t part) const {
+    return std::span(items_).subspan(parts_[part].item, parts_[part].itemEnd - parts_[part].item);
   }
 
-  /// visit(t, u) for every triangle t of this surface and u of `other` whose boxes overlap.
+  /// Each node of a part: its box, its normal cone, and whether none of its triangles moves (two
+  /// such nodes never touch).
+  void refitPart(std::size_t part, const SurfaceFrame& frame);
+
+  /// visit(t, u) once for every pair of two triangles of this surface, t in part i and u in part j
+  /// (i == j: both in part i), whose boxes overlap, but those the cones rule out (see above;
+  /// `closed`: a closed surface). Parts i <= j together give every pair once.
   template <typename Visit>
-  void pairsWith(const SurfaceTree& other, Visit&& visit) const {
-    if (!nodes_.empty() && !other.nodes_.empty()) across(other, 0, 0, false, visit);
+  void selfPairs(bool closed, std::size_t i, std::size_t j, Visit&& visit) const {
+    if (i == j)
+      self(parts_[i].node, closed, visit);
+    else
+      across(*this, parts_[i].node, parts_[j].node, closed, visit);
+  }
+
+  /// visit(t, u) for every triangle t of this surface's part i and u of `other`'s part j whose
+  /// boxes overlap.
+  template <typename Visit>
+  void pairsWith(const SurfaceTree& other, std::size_t i, std::size_t j, Visit&& visit) const {
+    across(other, parts_[i].node, other.parts_[j].node, false, visit);
   }
 
  private:
@@ -81,6 +101,11 @@ class SurfaceTree {
     Index count = 0;     ///< triangles in a leaf, 0 for an inner node
   };
   Index build(Index begin, Index end, std::span<const Vec3> centres, int depth);
+  struct Part {
+    Index node, nodeEnd;  ///< its subtree's nodes, [node, nodeEnd)
+    Index item, itemEnd;  ///< and their triangles' entries in items_
+  };
+  std::vector<Part> parts_;
 
   template <typename Visit>
   void self(Index n, bool closed, Visit& visit) const {

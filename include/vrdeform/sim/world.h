@@ -196,12 +196,13 @@ class World {
   void detectParticleContacts(const SolverTeam& team, std::vector<ColliderContact>& colliderContacts,
                               std::vector<FingertipContact>& fingertipContacts) const;
   void detectTriangleContacts();
-  void detectBodyContacts();
+  void prepareBodyContacts();
+  void detectBodyContacts(const SolverTeam& team);
   struct ContactSides;  // two bodies' frames and settings, for the narrow phase
-  ContactSides contactSides(BodyId a, BodyId b) const;
-  void detectTrianglePair(const ContactSides& ab, const ContactSides& ba, Index t, Index u);  // a's t, b's u
-  void detectVertexTriangle(const ContactSides& ab, Index vertex, Index triangle);  // a's vertex, b's triangle
-  void detectEdgeEdge(const ContactSides& ab, Index e, Index f);                    // a's edge, b's edge
+  ContactSides contactSides(BodyId a, BodyId b, std::vector<BodyContact>& found) const;
+  void detectTrianglePair(const ContactSides& ab, const ContactSides& ba, Index t, Index u) const;  // a's t, b's u
+  void detectVertexTriangle(const ContactSides& ab, Index vertex, Index triangle) const;  // a's vertex, b's triangle
+  void detectEdgeEdge(const ContactSides& ab, Index e, Index f) const;                    // a's edge, b's edge
   bool touching(BodyId a, BodyId b) const;                               // the pair's settings let them touch
   Box3f sweptBox(Index particle, const Vec3& offset, float grow) const;  // start to prediction, grown
   void solveBodyContacts(float invH);
@@ -271,7 +272,7 @@ class World {
     Index firstTriangleKey = 0, firstEdgeKey = 0;  // world-wide numbers of its first triangle and edge
   };
   static ContactSurface contactSurfaceOf(const BodyModel& model);
-  void markCreases(BodyId id);
+  void markCreases(BodyId id, std::size_t begin, std::size_t end);  // of its edges [begin, end)
   std::vector<BodyContactSettings> bodyContactSettings_;
   std::vector<ContactSurface> contactSurfaces_;
   std::vector<std::pair<BodyId, BodyId>> pairsOff_;  // (lower, higher), sorted
@@ -289,6 +290,15 @@ class World {
     Vec3 offset;                                 // the body's frame to the common one
   };
   std::vector<ContactBroadPhase> broadPhases_;  // per body
+  // A substep's work (prepareBodyContacts): the bodies that take part, their trees' parts, and the
+  // pairs of parts (of a body and itself, or of two bodies) to traverse.
+  std::vector<BodyId> contactBodies_;
+  std::vector<std::pair<BodyId, std::uint32_t>> contactParts_;
+  struct ContactTask {
+    BodyId a, b;
+    std::uint32_t i, j;  // a's part and b's
+  };
+  std::vector<ContactTask> contactTasks_;
   // The last substep's contacts, whose multipliers a warm start carries over.
   std::vector<ColliderContact> previousColliderContacts_;
   std::vector<FingertipContact> previousFingertipContacts_;
@@ -300,6 +310,7 @@ class World {
   struct MemberContacts {
     std::vector<ColliderContact> collider;
     std::vector<FingertipContact> fingertip;
+    std::vector<BodyContact> body;
   };
   std::vector<MemberContacts> memberContacts_;
   std::vector<std::uint8_t> memberFinite_;  // member k, body b at k * bodies + b
