@@ -6,6 +6,8 @@
 //    the contacts a step: found, and pushed (a non-zero multiplier).
 //  - SelfContactEightSubsteps/tets/self: the 10k block at 8 substeps of 1/480 s (the scene files'
 //    default) instead of one.
+//  - SelfContactOneThread/substeps/self: the 10k block on one thread (the others: as many as
+//    SolverSettings::threads gives, two on a 2-core machine), at 1 and 8 substeps.
 //  - Stack/tets: two such blocks, one resting on the other, contact between them on and off.
 
 #include <benchmark/benchmark.h>
@@ -53,12 +55,13 @@ void timeSteps(benchmark::State& state, World& world, std::size_t triangles) {
   state.counters["deepest_mm"] = 1e3 * double(deepest);
 }
 
-void selfContact(benchmark::State& state, int substeps) {
+void selfContact(benchmark::State& state, int tets, int substeps, int threads = SolverSettings::kAutoThreads) {
   SolverSettings settings;
   settings.timeStages = true;
   settings.substeps = substeps;
+  settings.threads = threads;
   World world(settings);
-  const auto model = block(int(state.range(0)));
+  const auto model = block(tets);
   const BodyId body = world.addBody(model);
   pinEnd(world, body);
   BodyContactSettings contact;
@@ -66,7 +69,7 @@ void selfContact(benchmark::State& state, int substeps) {
   world.setBodyContact(body, contact);
   timeSteps(state, world, model->surface.size());
 }
-void SelfContact(benchmark::State& state) { selfContact(state, 1); }
+void SelfContact(benchmark::State& state) { selfContact(state, int(state.range(0)), 1); }
 BENCHMARK(SelfContact)
     ->ArgNames({"tets", "self"})
     ->ArgsProduct({{1000, 10000, 100000}, {0, 1}})
@@ -75,10 +78,17 @@ BENCHMARK(SelfContact)
 
 // The same block at the scene files' 8 substeps a step: each substep's reach is an eighth, and the
 // block bends without crumpling onto itself at its clamp.
-void SelfContactEightSubsteps(benchmark::State& state) { selfContact(state, 8); }
+void SelfContactEightSubsteps(benchmark::State& state) { selfContact(state, int(state.range(0)), 8); }
 BENCHMARK(SelfContactEightSubsteps)
     ->ArgNames({"tets", "self"})
     ->ArgsProduct({{10000}, {0, 1}})
+    ->Iterations(kSteps)
+    ->Unit(benchmark::kMillisecond);
+
+void SelfContactOneThread(benchmark::State& state) { selfContact(state, 10000, int(state.range(0)), 1); }
+BENCHMARK(SelfContactOneThread)
+    ->ArgNames({"substeps", "self"})
+    ->ArgsProduct({{1, 8}, {0, 1}})
     ->Iterations(kSteps)
     ->Unit(benchmark::kMillisecond);
 
