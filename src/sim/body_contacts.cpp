@@ -182,7 +182,8 @@ void World::detectBodyContacts(const SolverTeam& team) {
     }
   }
   team.barrier();
-  // The triangles' and edges' boxes from their corners'.
+  // The trees' parts (their triangles' boxes from their corners', then the refit), and the edges'
+  // boxes and creases.
   const auto [p0, p1] = team.share(0, contactParts_.size(), 1);
   for (std::size_t k = p0; k < p1; ++k) {
     const auto [id, part] = contactParts_[k];

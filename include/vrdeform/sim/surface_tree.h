@@ -29,7 +29,7 @@ using Box3f = Eigen::AlignedBox<float, 3>;
 
 /// The directions within an angle of the unit `axis`, kept as its cosine and sine (no trigonometry
 /// in the tests); the full sphere where no direction has every normal on its positive side, or a
-/// normal is degenerate.
+/// normal is not finite.
 struct NormalCone {
   Vec3 axis = Vec3::UnitZ();
   float cos = 1.0f, sin = 0.0f;
