@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <limits>
+#include <numeric>
 #include <random>
 
 #include "sim/lane_sweeps.h"
@@ -456,6 +458,35 @@ TEST(Lanes, ThreadsGiveTheOneThreadResultExactly) {
         ASSERT_EQ(many[i], one[i]) << models.size() << " bodies, " << threads << " threads, particle " << i;
     }
   }
+}
+
+// SolverTeam::shareOut hands every item to exactly one member, call after call (each after a
+// barrier), whatever the count; a team of one takes them all in order.
+TEST(Lanes, ThreadsShareOutEveryItemOnce) {
+  const std::vector<std::size_t> counts{0, 1, 2, 5, 37, 1000, 3, 1000};
+  std::vector<std::atomic<int>> hits(1000);
+  ThreadTeam team(3);
+  std::array<std::atomic<std::size_t>, 3> taken{};
+  team.run([&](const SolverTeam& member) {
+    for (std::size_t count : counts) {
+      member.shareOut(count, [&](std::size_t i) {
+        hits[i].fetch_add(1, std::memory_order_relaxed);
+        taken[std::size_t(member.index)].fetch_add(1, std::memory_order_relaxed);
+      });
+      member.barrier();
+    }
+  });
+  for (std::size_t i = 0; i < hits.size(); ++i) {
+    int expected = 0;
+    for (std::size_t count : counts) expected += i < count ? 1 : 0;
+    ASSERT_EQ(hits[i].load(), expected) << "item " << i;
+  }
+  std::size_t total = 0;
+  for (const auto& t : taken) total += t.load();
+  EXPECT_EQ(total, std::accumulate(counts.begin(), counts.end(), std::size_t{0}));
+  std::vector<std::size_t> order;
+  SolverTeam{}.shareOut(5, [&](std::size_t i) { order.push_back(i); });
+  EXPECT_EQ(order, (std::vector<std::size_t>{0, 1, 2, 3, 4}));
 }
 
 // Body contact is found by the team too (each member a share of the boxes, the trees' parts and
