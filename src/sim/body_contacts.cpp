@@ -286,14 +286,26 @@ void World::markCreases(BodyId id, std::size_t begin, std::size_t end) {
 }
 
 // Triangle t of a and u of b (boxes overlapping; ba: the sides swapped): each one's vertices
-// against the other, and their edges against each other's.
+// against the other, and their edges against each other's, where their boxes overlap (and, within
+// a closed surface in self-contact, one of the two edges is a crease: markCreases).
 void World::detectTrianglePair(const ContactSides& ab, const ContactSides& ba, Index t, Index u) const {
   const ContactSurface &sa = ab.surfaceA, &sb = ab.surfaceB;
-  for (Index k = sa.vertexStart[t]; k < sa.vertexStart[t + 1]; ++k) detectVertexTriangle(ab, sa.ownedVertices[k], u);
-  for (Index k = sb.vertexStart[u]; k < sb.vertexStart[u + 1]; ++k) detectVertexTriangle(ba, sb.ownedVertices[k], t);
-  for (Index k = sa.edgeStart[t]; k < sa.edgeStart[t + 1]; ++k)
+  const ContactBroadPhase &broadA = ab.broadA, &broadB = ab.broadB;
+  for (Index k = sa.vertexStart[t]; k < sa.vertexStart[t + 1]; ++k)
+    if (const Index v = sa.ownedVertices[k]; overlap(broadA.vertexBoxes[v], broadB.boxes[u]))
+      detectVertexTriangle(ab, v, u);
+  for (Index k = sb.vertexStart[u]; k < sb.vertexStart[u + 1]; ++k)
+    if (const Index v = sb.ownedVertices[k]; overlap(broadB.vertexBoxes[v], broadA.boxes[t]))
+      detectVertexTriangle(ba, v, t);
+  const bool creasesOnly = ab.a == ab.b && !broadA.sharp.empty();
+  for (Index k = sa.edgeStart[t]; k < sa.edgeStart[t + 1]; ++k) {
+    const Index e = sa.ownedEdges[k];
+    const bool smooth = creasesOnly && !broadA.sharp[e];
     for (Index l = sb.edgeStart[u]; l < sb.edgeStart[u + 1]; ++l)
-      detectEdgeEdge(ab, sa.ownedEdges[k], sb.ownedEdges[l]);
+      if (const Index f = sb.ownedEdges[l];
+          !(smooth && !broadB.sharp[f]) && overlap(broadA.edgeBoxes[e], broadB.edgeBoxes[f]))
+        detectEdgeEdge(ab, e, f);
+  }
 }
 
 namespace {
@@ -305,9 +317,9 @@ bool shareCorner(std::span<const Index> f, std::span<const Index> g) {
 
 }  // namespace
 
-// Surface vertex `vertex` of a (its position in the surface's vertex list) against triangle t of b.
+// Surface vertex `vertex` of a (its position in the surface's vertex list) against triangle t of b,
+// their boxes overlapping.
 void World::detectVertexTriangle(const ContactSides& ab, Index vertex, Index t) const {
-  if (!ab.broadA.vertexBoxes[vertex].intersects(ab.broadB.boxes[t])) return;
   const Point* const pred = predicted_.data();
   const Point* const start = local_.data();
   const Index v = ab.surfaceA.vertices[vertex], i = ab.bodyA.firstParticle + v;
@@ -335,13 +347,11 @@ void World::detectVertexTriangle(const ContactSides& ab, Index vertex, Index t) 
   ab.found.push_back({p, {1.0f, -touch->b[0], -touch->b[1], -touch->b[2]}, 1, key, offset, touch->normal, ab.pair});
 }
 
-// Surface edges e of a and f of b (positions in the surfaces' edge lists). Within a body in
-// self-contact only pairs with a crease (markCreases), each from its lower edge: the same contact
-// (key, corner order) from every substep, for the warm start.
+// Surface edges e of a and f of b (positions in the surfaces' edge lists), their boxes
+// overlapping. Within a body, each pair from its lower edge: the same contact (key, corner order)
+// from every substep, for the warm start.
 void World::detectEdgeEdge(const ContactSides& ab, Index e, Index f) const {
   const bool self = ab.a == ab.b;
-  if (self && !ab.broadA.sharp.empty() && !ab.broadA.sharp[e] && !ab.broadA.sharp[f]) return;
-  if (!ab.broadA.edgeBoxes[e].intersects(ab.broadB.edgeBoxes[f])) return;
   if (self && f < e) std::swap(e, f);
   const Point* const pred = predicted_.data();
   const Point* const start = local_.data();
