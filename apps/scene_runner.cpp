@@ -114,11 +114,13 @@ void printSummary(const RunSummary& r, const BuiltScene& scene) {
     if (std::isfinite(r.residuals[s].max))
       fmt::print(" {} {:.1e} {:.1e};", stageName(Stage(s)), r.residuals[s].rms, r.residuals[s].max);
   fmt::print("\n");
-  if (r.coldSubstepShare >= 0.001)
+  if (r.coldSubstepShare >= 0.001 || r.coldSubstepsTouching > 0)
     fmt::print(
         "  warm start: {:.1f}% of the substeps started cold (their warm start would have moved a particle over a "
-        "quarter of its body's mean rest edge){}\n",
-        100 * r.coldSubstepShare, r.coldSubstepShare > 0.02 ? ": give the scene more substeps" : "");
+        "quarter of its body's mean rest edge), {} of them while a fingertip touched a body (each one a dip in the "
+        "force felt){}\n",
+        100 * r.coldSubstepShare, r.coldSubstepsTouching,
+        r.coldSubstepShare > 0.02 || r.coldSubstepsTouching > 0 ? ": give the scene more substeps" : "");
   fmt::print("  NaN events: {}\n", r.nanEvents);
   for (const std::string& e : r.events) fmt::print("    {}\n", e);
   const auto mean = [&](Stage s) { return r.latency.stage(s, Phase::All).mean; };

@@ -266,6 +266,7 @@ RunSummary runScene(BuiltScene& scene, const RunSettings& settings) {
       const StageTimes& times = session ? session->times() : world.lastStep().times;
       iterations += world.lastStep().iterations;
       coldSubsteps += world.lastStep().coldSubsteps;
+      if (contact) summary.coldSubstepsTouching += std::uint64_t(world.lastStep().coldSubsteps);
       for (std::size_t s = 0; s < kStageCount; ++s)
         if (const Residual& r = world.lastStep().residuals[s]; std::isfinite(r.max)) {
           residualRmsSum[s] += r.rms;
@@ -410,6 +411,7 @@ std::string summaryJson(const RunSummary& s) {
   j["residuals"] = residuals;
   j["iterations_mean"] = number(s.iterationsMean);
   j["cold_substep_share"] = number(s.coldSubstepShare);
+  j["cold_substeps_touching"] = s.coldSubstepsTouching;
   json stages = json::object();
   const auto stats = [&](const SampleStats& st) {
     return json{{"mean", number(st.mean)}, {"p50", number(st.median)}, {"p95", number(st.p95)},
