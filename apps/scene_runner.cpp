@@ -117,10 +117,10 @@ void printSummary(const RunSummary& r, const BuiltScene& scene) {
   if (r.coldSubstepShare >= 0.001 || r.coldSubstepsTouching > 0)
     fmt::print(
         "  warm start: {:.1f}% of the substeps started cold (their warm start would have moved a particle over a "
-        "quarter of its body's mean rest edge), {} of them while a fingertip touched a body (each one a dip in the "
-        "force felt){}\n",
+        "quarter of its body's mean rest edge), {} of them while a fingertip touched a body (where the force can "
+        "dip: more substeps remove them){}\n",
         100 * r.coldSubstepShare, r.coldSubstepsTouching,
-        r.coldSubstepShare > 0.02 || r.coldSubstepsTouching > 0 ? ": give the scene more substeps" : "");
+        r.coldSubstepShare > 0.02 ? ": give the scene more substeps" : "");
   fmt::print("  NaN events: {}\n", r.nanEvents);
   for (const std::string& e : r.events) fmt::print("    {}\n", e);
   const auto mean = [&](Stage s) { return r.latency.stage(s, Phase::All).mean; };
