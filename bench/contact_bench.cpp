@@ -4,7 +4,7 @@
 //    and on. Counters: the surface's triangles, the detection and body-contact solve times per step
 //    (StepReport stage times), so that detection's growth with the surface shows in one table, and
 //    the contacts a step: found, and pushed (a non-zero multiplier).
-//  - SelfContactEightSubsteps/tets/self: the 10k block at 8 substeps of 1/480 s (the scene files'
+//  - SelfContactEightSubsteps/tets/self: the blocks at 8 substeps of 1/480 s (the scene files'
 //    default) instead of one.
 //  - SelfContactOneThread/substeps/self: the 10k block on one thread (the others: as many as
 //    SolverSettings::threads gives, two on a 2-core machine), at 1 and 8 substeps.
