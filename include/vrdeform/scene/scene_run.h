@@ -82,9 +82,8 @@ struct RunSummary {
   /// With a warm start, the share of substeps that started cold because it would have moved a
   /// particle too far (World::warmPushesFit): more than a few percent asks for more substeps.
   double coldSubstepShare = 0.0;
-  /// Of those, the ones in steps where a fingertip touched a body: each one is a dip in what the
-  /// finger feels (the substep rebuilds its contacts' multipliers from zero), so a scene whose pokes
-  /// should feel smooth needs none.
+  /// Of those, the ones in steps where a fingertip touched a body: each can be a dip in what the
+  /// finger feels (the substep rebuilds its contacts' multipliers from zero; docs/haptics.md).
   std::uint64_t coldSubstepsTouching = 0;
   std::uint64_t nanEvents = 0;      ///< bodies frozen or particles reset after a NaN
   std::vector<std::string> events;  ///< what the first 100 of them were

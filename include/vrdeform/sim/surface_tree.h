@@ -30,9 +30,10 @@ using Box3f = Eigen::AlignedBox<float, 3>;
 /// Whether two boxes overlap: all six comparisons and one branch (the detection's tests pass about
 /// half the time, so a branch per axis would often be mispredicted).
 inline bool overlap(const Box3f& a, const Box3f& b) {
+  const auto below = [](float x, float y) { return int(x <= y); };
   const Vec3 &amin = a.min(), &amax = a.max(), &bmin = b.min(), &bmax = b.max();
-  return bool((amin.x() <= bmax.x()) & (bmin.x() <= amax.x()) & (amin.y() <= bmax.y()) & (bmin.y() <= amax.y()) &
-              (amin.z() <= bmax.z()) & (bmin.z() <= amax.z()));
+  return (below(amin.x(), bmax.x()) & below(bmin.x(), amax.x()) & below(amin.y(), bmax.y()) &
+          below(bmin.y(), amax.y()) & below(amin.z(), bmax.z()) & below(bmin.z(), amax.z())) != 0;
 }
 
 /// The directions within an angle of the unit `axis`, kept as its cosine and sine (no trigonometry
