@@ -217,7 +217,7 @@ TEST(SceneRun, CountsTheColdSubstepsWhileAFingertipTouches) {
   const RunSummary r = runScene(scene, settings);
   EXPECT_GT(r.coldSubstepsTouching, 0u);
   EXPECT_EQ(r.coldSubstepsTouching, touching);
-  EXPECT_NEAR(r.coldSubstepShare, double(all) / double(r.steps * 8), 1e-12);
+  EXPECT_NEAR(r.coldSubstepShare, double(all) / double(r.steps * std::uint64_t(spec.solver.substeps)), 1e-12);
   ASSERT_EQ(r.pokes.size(), 1u);
   EXPECT_GT(r.pokes[0].newtons.roughness, 1.10);
   testing::record("cold_substeps_touching", double(r.coldSubstepsTouching));
